@@ -1,0 +1,65 @@
+//! Random jittered, rotated meshes shared by the property tests.
+#![allow(dead_code)]
+
+use proptest::prelude::*;
+use umls_mesh::SimplexMesh;
+use umls_mesh::generate::{Diagonal, Lattice, Spacing};
+
+/// Random graded, jittered interval meshes.
+pub fn interval() -> impl Strategy<Value = SimplexMesh<1>> {
+    (1usize..30, 0.0f64..0.25, any::<u64>(), 0.2f64..5.0).prop_map(|(n, jitter, seed, ratio)| {
+        Lattice::new([-1.0], [2.0], [n])
+            .spacing([Spacing::Graded { ratio }])
+            .jitter(jitter, seed)
+            .segments()
+            .expect("valid interval")
+    })
+}
+
+/// Any triangle split pattern.
+pub fn diagonal() -> impl Strategy<Value = Diagonal> {
+    prop_oneof![
+        Just(Diagonal::Right),
+        Just(Diagonal::Left),
+        Just(Diagonal::Alternating),
+        Just(Diagonal::Crossed)
+    ]
+}
+
+/// Random jittered, rotated rectangle meshes with any split pattern.
+pub fn rectangle() -> impl Strategy<Value = SimplexMesh<2>> {
+    (
+        1usize..9,
+        1usize..9,
+        0.0f64..0.25,
+        any::<u64>(),
+        0.0f64..6.3,
+        diagonal(),
+    )
+        .prop_map(|(nx, ny, jitter, seed, angle, diagonal)| {
+            Lattice::new([0.0, 0.0], [2.0, 1.0], [nx, ny])
+                .jitter(jitter, seed)
+                .rotate_by(angle)
+                .triangles(diagonal)
+                .expect("valid rectangle")
+        })
+}
+
+/// Random jittered, rotated box tetrahedralisations.
+pub fn cuboid() -> impl Strategy<Value = SimplexMesh<3>> {
+    (
+        1usize..5,
+        1usize..5,
+        1usize..5,
+        0.0f64..0.25,
+        any::<u64>(),
+        0.0f64..6.3,
+    )
+        .prop_map(|(nx, ny, nz, jitter, seed, angle)| {
+            Lattice::new([0.0, 0.0, 0.0], [1.0, 1.5, 0.5], [nx, ny, nz])
+                .jitter(jitter, seed)
+                .rotate_about([1.0, 2.0, 3.0], angle)
+                .tetrahedra()
+                .expect("valid box")
+        })
+}

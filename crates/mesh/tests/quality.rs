@@ -1,0 +1,171 @@
+//! Quality measures against closed-form values, and generator options.
+
+use std::f64::consts::PI;
+
+use nalgebra::{Vector2, Vector3};
+use umls_mesh::generate::{Diagonal, Lattice, Spacing};
+use umls_mesh::{MeshError, Orientation, SimplexMesh};
+
+#[test]
+fn equilateral_triangle_and_regular_tetrahedron_score_one() {
+    let h = 3f64.sqrt() / 2.0;
+    let tri = SimplexMesh::new(
+        vec![
+            Vector2::new(0.0, 0.0),
+            Vector2::new(1.0, 0.0),
+            Vector2::new(0.5, h),
+        ],
+        vec![0, 1, 2],
+        Orientation::Fix,
+    )
+    .unwrap();
+    let q = tri.simplex_quality(0);
+    assert!((q.radius_ratio - 1.0).abs() < 1e-14);
+    assert!((q.min_angle.unwrap() - PI / 3.0).abs() < 1e-14);
+    assert!((q.max_angle.unwrap() - PI / 3.0).abs() < 1e-14);
+    assert!((q.edge_ratio - 1.0).abs() < 1e-14);
+
+    let s = 1.0 / 2f64.sqrt();
+    let tet = SimplexMesh::new(
+        vec![
+            Vector3::new(1.0, 0.0, -s),
+            Vector3::new(-1.0, 0.0, -s),
+            Vector3::new(0.0, 1.0, s),
+            Vector3::new(0.0, -1.0, s),
+        ],
+        vec![0, 1, 2, 3],
+        Orientation::Fix,
+    )
+    .unwrap();
+    let q = tet.simplex_quality(0);
+    assert!((q.radius_ratio - 1.0).abs() < 1e-14);
+    // Regular tetrahedron dihedral angle: acos(1/3).
+    assert!((q.min_angle.unwrap() - (1.0f64 / 3.0).acos()).abs() < 1e-14);
+}
+
+#[test]
+fn right_isosceles_triangle_values() {
+    let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [1, 1])
+        .triangles(Diagonal::Right)
+        .unwrap();
+    let q = mesh.simplex_quality(0);
+    // r = (2 − √2)/2, R = √2/2 → 2r/R = 2√2 − 2.
+    assert!((q.radius_ratio - (2.0 * 2f64.sqrt() - 2.0)).abs() < 1e-14);
+    assert!((q.min_angle.unwrap() - PI / 4.0).abs() < 1e-14);
+    assert!((q.max_angle.unwrap() - PI / 2.0).abs() < 1e-14);
+    assert!((q.edge_ratio - 2f64.sqrt()).abs() < 1e-14);
+    let summary = mesh.quality_summary();
+    assert_eq!(summary.simplices, 2);
+    assert!((summary.max_volume - 0.5).abs() < 1e-15);
+}
+
+#[test]
+fn kuhn_tetrahedra_dihedral_angles() {
+    // Every Kuhn (path) tetrahedron has dihedral angles 45°, 60° and 90° only.
+    let mesh = Lattice::new([0.0; 3], [1.0; 3], [2, 2, 2])
+        .tetrahedra()
+        .unwrap();
+    let summary = mesh.quality_summary();
+    assert!((summary.min_angle.unwrap() - PI / 4.0).abs() < 1e-12);
+    assert!((summary.max_angle.unwrap() - PI / 2.0).abs() < 1e-12);
+    assert_eq!(mesh.simplex_count(), 48);
+    assert!((summary.min_volume - summary.max_volume).abs() < 1e-15);
+}
+
+#[test]
+fn graded_spacing_has_requested_ratio() {
+    let mesh = Lattice::new([0.0], [1.0], [10])
+        .spacing([Spacing::Graded { ratio: 4.0 }])
+        .segments()
+        .unwrap();
+    let first = mesh.volume(0);
+    let last = mesh.volume(9);
+    assert!((last / first - 4.0).abs() < 1e-12);
+    assert!((mesh.total_volume() - 1.0).abs() < 1e-14);
+}
+
+#[test]
+fn rotation_preserves_quality_and_volume() {
+    let base = Lattice::new([0.0, 0.0], [2.0, 1.0], [6, 3]).jitter(0.2, 3);
+    let plain = base.clone().triangles(Diagonal::Alternating).unwrap();
+    let turned = base
+        .rotate_by(0.7)
+        .triangles(Diagonal::Alternating)
+        .unwrap();
+    let (a, b) = (plain.quality_summary(), turned.quality_summary());
+    assert!((a.min_radius_ratio - b.min_radius_ratio).abs() < 1e-12);
+    assert!((plain.total_volume() - turned.total_volume()).abs() < 1e-12);
+    assert!(
+        plain
+            .vertices()
+            .iter()
+            .zip(turned.vertices())
+            .any(|(p, q)| (p - q).norm() > 0.1)
+    );
+}
+
+#[test]
+fn generator_rejects_bad_parameters() {
+    let err = Lattice::new([0.0, 0.0], [1.0, 1.0], [0, 3])
+        .triangles(Diagonal::Right)
+        .unwrap_err();
+    assert!(matches!(
+        err,
+        MeshError::InvalidParameter {
+            parameter: "cells",
+            ..
+        }
+    ));
+    let err = Lattice::new([0.0], [1.0], [3])
+        .jitter(0.6, 1)
+        .segments()
+        .unwrap_err();
+    assert!(matches!(
+        err,
+        MeshError::InvalidParameter {
+            parameter: "jitter",
+            ..
+        }
+    ));
+    let err = Lattice::new([1.0], [0.0], [3]).segments().unwrap_err();
+    assert!(matches!(
+        err,
+        MeshError::InvalidParameter {
+            parameter: "lower/upper",
+            ..
+        }
+    ));
+    let err = Lattice::new([0.0; 3], [1.0; 3], [1, 1, 1])
+        .rotate_about([0.0; 3], 1.0)
+        .tetrahedra()
+        .unwrap_err();
+    assert!(matches!(
+        err,
+        MeshError::InvalidParameter {
+            parameter: "rotation",
+            ..
+        }
+    ));
+    let err = Lattice::new([0.0], [1.0], [3])
+        .spacing([Spacing::Graded { ratio: -1.0 }])
+        .segments()
+        .unwrap_err();
+    assert!(matches!(
+        err,
+        MeshError::InvalidParameter {
+            parameter: "spacing ratio",
+            ..
+        }
+    ));
+}
+
+#[test]
+fn crossed_pattern_adds_centres() {
+    let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [3, 2])
+        .jitter(0.2, 9)
+        .triangles(Diagonal::Crossed)
+        .unwrap();
+    assert_eq!(mesh.vertex_count(), 12 + 6);
+    assert_eq!(mesh.simplex_count(), 24);
+    assert_eq!(mesh.entity_counts().euler_characteristic(), 1);
+}

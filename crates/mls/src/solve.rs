@@ -1,0 +1,212 @@
+//! The MLS solve: moment matrix, conditioning, shape functions and their gradients.
+//!
+//! With the basis centred at the evaluation point x and scaled by s,
+//! p_v = p((x_v − x)/s), M = Σ_v w_v p_v p_vᵀ and a = M⁻¹ e₀:
+//!
+//! - N_v = w_v aᵀ p_v,
+//! - reconstructed gradient ∇̃_k N_v = w_v (M⁻¹ e_{k+1})ᵀ p_v / s,
+//! - full gradient ∂_k N_v = ∇̃_k N_v + ∂_k w_v g_v − r_kᵀ c_v, with g_v = aᵀ p_v,
+//!   c_v = M⁻¹ w_v p_v and r_k = Σ_u ∂_k w_u g_u p_u.
+//!
+//! The full gradient follows from differentiating N_v with the basis centre held fixed
+//! (MLS shape functions do not depend on where a complete basis is centred), so that only
+//! the weights depend on x; the terms are then evaluated with the centre at x.
+
+use nalgebra::{Cholesky, SMatrix, SVector};
+
+use crate::basis::PolynomialBasis;
+use crate::error::MlsError;
+use crate::stencil::{GradientKind, MAX_STENCIL, Stencil};
+
+/// What to do when the moment matrix is ill-conditioned.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum IllConditionedPolicy {
+    /// Return [`MlsError::IllConditioned`].
+    Fail,
+    /// Add `strength · tr(M)/N` to the diagonal entries of the non-constant monomials and
+    /// solve again (Tikhonov regularisation that leaves the constant unpenalised, so
+    /// partition of unity still holds exactly; linear reproduction degrades by O(strength)).
+    Regularize {
+        /// Relative regularisation strength, e.g. 1e-6.
+        strength: f64,
+    },
+}
+
+/// Conditioning limit and policy for the moment matrix.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Conditioning {
+    /// Largest accepted 1-norm condition number of the scaled moment matrix.
+    pub max_condition: f64,
+    /// What to do beyond it.
+    pub policy: IllConditionedPolicy,
+}
+
+impl Default for Conditioning {
+    /// Limit 1e8 (well-shaped stencils measure 10¹–10³ with the scaled basis), fail beyond.
+    fn default() -> Self {
+        Self {
+            max_condition: 1e8,
+            policy: IllConditionedPolicy::Fail,
+        }
+    }
+}
+
+/// Samples for one MLS evaluation at a point x.
+#[derive(Debug, Clone, Copy)]
+pub struct Samples<'a, const D: usize> {
+    /// Node indices reported in the stencil.
+    pub nodes: &'a [u32],
+    /// Sample positions x_v.
+    pub positions: &'a [SVector<f64, D>],
+    /// Weights w_v(x) ≥ 0.
+    pub weights: &'a [f64],
+    /// Weight gradients ∇w_v(x); only read for [`GradientKind::Full`] (may be empty otherwise).
+    pub weight_gradients: &'a [SVector<f64, D>],
+}
+
+/// Computes MLS shape functions at `x` into `out`.
+///
+/// `scale` is a length of the order of the sample spacing: coordinates are divided by it
+/// so the moment matrix is O(1) and its condition number means something. It does not
+/// change the result (beyond round-off).
+pub fn shape_functions<const D: usize, const N: usize, B: PolynomialBasis<D, N>>(
+    x: &SVector<f64, D>,
+    samples: &Samples<'_, D>,
+    scale: f64,
+    gradient: GradientKind,
+    conditioning: &Conditioning,
+    out: &mut Stencil<D>,
+) -> Result<(), MlsError> {
+    let n = samples.positions.len();
+    let needs_weight_gradients = gradient == GradientKind::Full;
+    if samples.weights.len() != n
+        || samples.nodes.len() != n
+        || (needs_weight_gradients && samples.weight_gradients.len() != n)
+    {
+        return Err(MlsError::LengthMismatch {
+            positions: n,
+            weights: samples.weights.len(),
+            gradients: samples.weight_gradients.len(),
+        });
+    }
+    if n > MAX_STENCIL {
+        return Err(MlsError::StencilOverflow {
+            simplex: None,
+            samples: n,
+            capacity: MAX_STENCIL,
+        });
+    }
+    if !(scale.is_finite() && scale > 0.0) {
+        return Err(MlsError::InvalidParameter {
+            parameter: "scale",
+            value: scale,
+            reason: "must be finite and positive",
+        });
+    }
+    let inv_scale = 1.0 / scale;
+    let basis = |v: usize| B::evaluate(&((samples.positions[v] - x) * inv_scale));
+
+    let mut moment = SMatrix::<f64, N, N>::zeros();
+    let mut positive = 0;
+    for (v, &w) in samples.weights.iter().enumerate() {
+        if !(w.is_finite() && w >= 0.0) {
+            return Err(MlsError::InvalidWeight {
+                sample: v,
+                weight: w,
+            });
+        }
+        if w > 0.0 {
+            let p = basis(v);
+            moment.ger(w, &p, &p, 1.0);
+            positive += 1;
+        }
+    }
+    let (inverse, condition) = invert(moment, positive, conditioning)?;
+
+    out.len = n;
+    out.nodes[..n].copy_from_slice(samples.nodes);
+    out.condition = condition;
+    out.gradient_kind = gradient;
+    let a = inverse.column(0).into_owned();
+    for v in 0..n {
+        let w = samples.weights[v];
+        let p = basis(v);
+        let g = a.dot(&p);
+        out.values[v] = w * g;
+        out.gradients[v] =
+            SVector::<f64, D>::from_fn(|k, _| w * inverse.column(k + 1).dot(&p) * inv_scale);
+    }
+    if needs_weight_gradients {
+        // r_k = Σ_u ∂_k w_u g_u p_u, stored as the columns of an N×D matrix.
+        let mut r = SMatrix::<f64, N, D>::zeros();
+        for u in 0..n {
+            let p = basis(u);
+            let g = a.dot(&p);
+            r += p * (samples.weight_gradients[u] * g).transpose();
+        }
+        for v in 0..n {
+            let p = basis(v);
+            let g = a.dot(&p);
+            let c = inverse * p * samples.weights[v];
+            out.gradients[v] += samples.weight_gradients[v] * g - r.transpose() * c;
+        }
+    }
+    Ok(())
+}
+
+/// Inverts the SPD moment matrix, estimating κ₁ = ‖M‖₁‖M⁻¹‖₁ and applying the policy.
+fn invert<const N: usize>(
+    moment: SMatrix<f64, N, N>,
+    positive: usize,
+    conditioning: &Conditioning,
+) -> Result<(SMatrix<f64, N, N>, f64), MlsError> {
+    let attempt = |m: SMatrix<f64, N, N>| -> (Option<SMatrix<f64, N, N>>, f64) {
+        match Cholesky::new(m) {
+            Some(chol) => {
+                let inverse = chol.inverse();
+                let condition = one_norm(&m) * one_norm(&inverse);
+                (
+                    Some(inverse),
+                    if condition.is_finite() {
+                        condition
+                    } else {
+                        f64::INFINITY
+                    },
+                )
+            }
+            None => (None, f64::INFINITY),
+        }
+    };
+    let fail = |condition| MlsError::IllConditioned {
+        simplex: None,
+        condition,
+        limit: conditioning.max_condition,
+        samples: positive,
+        basis: N,
+    };
+    let (inverse, condition) = attempt(moment);
+    if let Some(inverse) = inverse {
+        if condition <= conditioning.max_condition {
+            return Ok((inverse, condition));
+        }
+    }
+    match conditioning.policy {
+        IllConditionedPolicy::Fail => Err(fail(condition)),
+        IllConditionedPolicy::Regularize { strength } => {
+            let mut regularized = moment;
+            let shift = strength * moment.trace() / N as f64;
+            for i in 1..N {
+                regularized[(i, i)] += shift;
+            }
+            match attempt(regularized) {
+                (Some(inverse), c) if c.is_finite() => Ok((inverse, c)),
+                (_, c) => Err(fail(c)),
+            }
+        }
+    }
+}
+
+/// Maximum absolute column sum.
+fn one_norm<const N: usize>(m: &SMatrix<f64, N, N>) -> f64 {
+    m.column_iter().map(|c| c.abs().sum()).fold(0.0, f64::max)
+}

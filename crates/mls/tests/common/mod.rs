@@ -1,0 +1,104 @@
+//! Shared mesh strategies and helpers for the MLS property tests.
+#![allow(dead_code)]
+
+use nalgebra::SVector;
+use proptest::prelude::*;
+use umls_mesh::SimplexMesh;
+use umls_mesh::generate::{Diagonal, Lattice};
+
+/// Random graded, jittered interval meshes.
+pub fn interval() -> impl Strategy<Value = SimplexMesh<1>> {
+    (4usize..20, 0.0f64..0.25, any::<u64>()).prop_map(|(n, jitter, seed)| {
+        Lattice::new([-1.0], [1.0], [n])
+            .jitter(jitter, seed)
+            .segments()
+            .unwrap()
+    })
+}
+
+/// Random jittered, rotated rectangle meshes with any split pattern.
+pub fn rectangle() -> impl Strategy<Value = SimplexMesh<2>> {
+    let diagonal = prop_oneof![
+        Just(Diagonal::Right),
+        Just(Diagonal::Alternating),
+        Just(Diagonal::Crossed)
+    ];
+    (
+        3usize..8,
+        3usize..8,
+        0.0f64..0.25,
+        any::<u64>(),
+        0.0f64..6.3,
+        diagonal,
+    )
+        .prop_map(|(nx, ny, jitter, seed, angle, diagonal)| {
+            Lattice::new([0.0, 0.0], [1.0, 1.0], [nx, ny])
+                .jitter(jitter, seed)
+                .rotate_by(angle)
+                .triangles(diagonal)
+                .unwrap()
+        })
+}
+
+/// Random jittered, rotated box tetrahedralisations.
+pub fn cuboid() -> impl Strategy<Value = SimplexMesh<3>> {
+    (
+        2usize..4,
+        2usize..4,
+        2usize..4,
+        0.0f64..0.25,
+        any::<u64>(),
+        0.0f64..6.3,
+    )
+        .prop_map(|(nx, ny, nz, jitter, seed, angle)| {
+            Lattice::new([0.0; 3], [1.0; 3], [nx, ny, nz])
+                .jitter(jitter, seed)
+                .rotate_about([0.3, -1.0, 0.5], angle)
+                .tetrahedra()
+                .unwrap()
+        })
+}
+
+/// A point inside simplex `s` from D+1 positive weights (normalised to barycentric coordinates).
+pub fn point_in<const D: usize>(mesh: &SimplexMesh<D>, s: usize, raw: &[f64]) -> SVector<f64, D> {
+    let total: f64 = raw[..=D].iter().sum();
+    mesh.simplex(s)
+        .iter()
+        .zip(raw)
+        .fold(SVector::zeros(), |acc, (&v, &w)| {
+            acc + mesh.vertex(v as usize) * (w / total)
+        })
+}
+
+/// Whether every vertex of simplex `s` is interior (its 1-ring is complete).
+pub fn is_interior<const D: usize>(mesh: &SimplexMesh<D>, s: usize) -> bool {
+    mesh.simplex(s).iter().all(|v| {
+        mesh.topology()
+            .boundary_vertices()
+            .binary_search(v)
+            .is_err()
+    })
+}
+
+/// Simplices whose vertices are all interior, or every simplex if there are none.
+pub fn interior_simplices<const D: usize>(mesh: &SimplexMesh<D>) -> Vec<usize> {
+    let interior: Vec<usize> = (0..mesh.simplex_count())
+        .filter(|&s| is_interior(mesh, s))
+        .collect();
+    assert!(
+        !interior.is_empty(),
+        "mesh too coarse to have interior simplices"
+    );
+    interior
+}
+
+/// A larger box for the quadratic basis: enough cells for simplices with complete 1-rings.
+pub fn fine_cuboid() -> impl Strategy<Value = SimplexMesh<3>> {
+    (4usize..6, 0.0f64..0.25, any::<u64>(), 0.0f64..6.3).prop_map(|(n, jitter, seed, angle)| {
+        Lattice::new([0.0; 3], [1.0; 3], [n, n, n])
+            .jitter(jitter, seed)
+            .rotate_about([0.3, -1.0, 0.5], angle)
+            .tetrahedra()
+            .unwrap()
+    })
+}

@@ -1,0 +1,229 @@
+//! Ill-conditioned moment matrices: typed errors naming the simplex, or the documented
+//! regularisation; and the other error paths of the UMLS kernel.
+
+use nalgebra::{Vector1, Vector2};
+use umls_mesh::generate::{Diagonal, Lattice};
+use umls_mls::{
+    Conditioning, GradientKind, IllConditionedPolicy, Linear, MlsError, Quadratic, Stencil,
+    SupportRadius, UmlsKernel, WendlandC2,
+};
+
+/// At the end vertex of a 1D mesh only two samples carry weight (η of the third vanishes),
+/// too few for three quadratic monomials.
+#[test]
+fn too_few_weighted_samples_fail_naming_the_simplex() {
+    let line = Lattice::new([0.0], [1.0], [6]).segments().unwrap();
+    let kernel = UmlsKernel::new(&line);
+    let mut st = Stencil::new();
+    let err = kernel
+        .evaluate::<3, Quadratic>(
+            &line,
+            0,
+            &Vector1::new(0.0),
+            GradientKind::Reconstructed,
+            &mut st,
+        )
+        .unwrap_err();
+    match &err {
+        MlsError::IllConditioned {
+            simplex,
+            samples,
+            basis,
+            ..
+        } => {
+            assert_eq!((*simplex, *samples, *basis), (Some(0), 2, 3));
+        }
+        other => panic!("unexpected {other}"),
+    }
+    assert!(err.to_string().contains("in simplex 0"), "{err}");
+    // The linear basis is fine there, and reproduces x exactly.
+    kernel
+        .evaluate::<2, Linear>(
+            &line,
+            0,
+            &Vector1::new(0.0),
+            GradientKind::Reconstructed,
+            &mut st,
+        )
+        .unwrap();
+    let x: f64 = st
+        .iter()
+        .map(|(v, n, _)| n * line.vertex(v as usize)[0])
+        .sum();
+    assert!(x.abs() < 1e-15);
+}
+
+#[test]
+fn regularisation_keeps_partition_of_unity() {
+    let line = Lattice::new([0.0], [1.0], [6]).segments().unwrap();
+    let mut kernel = UmlsKernel::new(&line);
+    kernel.conditioning = Conditioning {
+        policy: IllConditionedPolicy::Regularize { strength: 1e-6 },
+        ..Conditioning::default()
+    };
+    let mut st = Stencil::new();
+    kernel
+        .evaluate::<3, Quadratic>(&line, 0, &Vector1::new(0.0), GradientKind::Full, &mut st)
+        .unwrap();
+    let sum: f64 = st.values().iter().sum();
+    assert!((sum - 1.0).abs() < 1e-12, "partition of unity {sum}");
+    // Linear reproduction degrades by O(strength) only.
+    let x: f64 = st
+        .iter()
+        .map(|(v, n, _)| n * line.vertex(v as usize)[0])
+        .sum();
+    assert!(x.abs() < 1e-5, "x = {x}");
+    assert!(st.condition_number().is_finite());
+}
+
+/// A sliver mesh (aspect ratio 10⁷): every stencil is nearly collinear and the linear
+/// moment matrix is ill-conditioned.
+#[test]
+fn sliver_elements_are_detected_and_regularised() {
+    let mesh = Lattice::new([0.0, 0.0], [1.0, 1e-7], [8, 2])
+        .triangles(Diagonal::Right)
+        .unwrap();
+    let mut kernel = UmlsKernel::new(&mesh);
+    let mut st = Stencil::new();
+    let x = mesh.centroid(5);
+    let err = kernel
+        .evaluate::<3, Linear>(&mesh, 5, &x, GradientKind::Reconstructed, &mut st)
+        .unwrap_err();
+    match err {
+        MlsError::IllConditioned {
+            simplex,
+            condition,
+            limit,
+            ..
+        } => {
+            assert_eq!(simplex, Some(5));
+            assert!(
+                condition > limit && condition > 1e12,
+                "condition {condition}"
+            );
+        }
+        other => panic!("unexpected {other}"),
+    }
+    kernel.conditioning.policy = IllConditionedPolicy::Regularize { strength: 1e-8 };
+    kernel
+        .evaluate::<3, Linear>(&mesh, 5, &x, GradientKind::Reconstructed, &mut st)
+        .unwrap();
+    assert!((st.values().iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    // Along the well-resolved axis the fit still reproduces x.
+    let x_fit: f64 = st
+        .iter()
+        .map(|(v, n, _)| n * mesh.vertex(v as usize).x)
+        .sum();
+    assert!((x_fit - x.x).abs() < 1e-6);
+}
+
+#[test]
+fn well_shaped_stencils_are_well_conditioned() {
+    let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [10, 10])
+        .jitter(0.2, 2)
+        .triangles(Diagonal::Alternating)
+        .unwrap();
+    let kernel = UmlsKernel::new(&mesh);
+    let mut st = Stencil::new();
+    let worst = (0..mesh.simplex_count())
+        .map(|s| {
+            kernel
+                .evaluate::<3, Linear>(
+                    &mesh,
+                    s as u32,
+                    &mesh.centroid(s),
+                    GradientKind::Reconstructed,
+                    &mut st,
+                )
+                .unwrap();
+            st.condition_number()
+        })
+        .fold(0.0, f64::max);
+    eprintln!("worst condition number, linear basis, jittered 10x10: {worst:.1}");
+    assert!(worst < 1e3, "{worst}");
+}
+
+#[test]
+fn kernel_error_paths() {
+    let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [3, 3])
+        .triangles(Diagonal::Right)
+        .unwrap();
+    let kernel = UmlsKernel::new(&mesh);
+    let mut st = Stencil::new();
+    let far = Vector2::new(5.0, 5.0);
+    assert!(matches!(
+        kernel.evaluate::<3, Linear>(&mesh, 0, &far, GradientKind::Reconstructed, &mut st),
+        Err(MlsError::OutsideHost { simplex: 0, .. })
+    ));
+    assert!(matches!(
+        kernel.evaluate::<3, Linear>(&mesh, 99, &far, GradientKind::Reconstructed, &mut st),
+        Err(MlsError::NoSuchSimplex {
+            simplex: 99,
+            count: 18
+        })
+    ));
+    assert!(matches!(
+        kernel.evaluate_at::<3, Linear>(&mesh, &far, Some(0), GradientKind::Reconstructed, &mut st),
+        Err(MlsError::OutsideMesh { .. })
+    ));
+    let other = Lattice::new([0.0, 0.0], [1.0, 1.0], [4, 4])
+        .triangles(Diagonal::Right)
+        .unwrap();
+    assert!(matches!(
+        kernel.evaluate::<3, Linear>(
+            &other,
+            0,
+            &other.centroid(0),
+            GradientKind::Reconstructed,
+            &mut st
+        ),
+        Err(MlsError::InvalidParameter {
+            parameter: "mesh vertex count",
+            ..
+        })
+    ));
+    assert!(
+        UmlsKernel::with_weight(&mesh, WendlandC2, SupportRadius::Global { factor: 0.0 }).is_err()
+    );
+    // Field shorter than the node indices.
+    kernel
+        .evaluate::<3, Linear>(
+            &mesh,
+            0,
+            &mesh.centroid(0),
+            GradientKind::Reconstructed,
+            &mut st,
+        )
+        .unwrap();
+    assert!(matches!(
+        st.interpolate(&[1.0, 2.0]),
+        Err(MlsError::FieldTooShort { len: 2, .. })
+    ));
+}
+
+/// Per-vertex radii keep every stencil distance within r ≤ 1 (so d_v ≥ W(1) > 0); the
+/// global rule uses the longest edge.
+#[test]
+fn support_radii_cover_every_stencil() {
+    let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [6, 6])
+        .jitter(0.25, 8)
+        .triangles(Diagonal::Crossed)
+        .unwrap();
+    let kernel = UmlsKernel::new(&mesh);
+    for s in 0..mesh.simplex_count() {
+        for &v in mesh.topology().one_ring(s).vertices {
+            for &n in mesh.simplex(s) {
+                let d = (mesh.vertex(v as usize) - mesh.vertex(n as usize)).norm();
+                assert!(d <= kernel.support_radii()[v as usize] * (1.0 + 1e-12));
+            }
+        }
+    }
+    let global =
+        UmlsKernel::with_weight(&mesh, WendlandC2, SupportRadius::Global { factor: 1.0 }).unwrap();
+    assert!(
+        global
+            .support_radii()
+            .iter()
+            .all(|&h| h == mesh.max_edge_length())
+    );
+}

@@ -1,0 +1,156 @@
+//! Partition of unity and polynomial reproduction of the UMLS shape functions, for both
+//! gradients, on random jittered and rotated meshes in 1D, 2D and 3D.
+
+mod common;
+
+use nalgebra::{SMatrix, SVector};
+use proptest::prelude::*;
+use umls_mesh::SimplexMesh;
+use umls_mls::{GradientKind, Linear, PolynomialBasis, Quadratic, Stencil, UmlsKernel};
+
+/// Σ N_v = 1, Σ ∇N_v = 0, Σ N_v x_v = x, Σ x_v ∇N_vᵀ = I, for the linear basis.
+fn check_linear<const D: usize, const N: usize>(
+    mesh: &SimplexMesh<D>,
+    s: usize,
+    raw: &[f64],
+    gradient: GradientKind,
+) -> Result<(), TestCaseError>
+where
+    Linear: PolynomialBasis<D, N>,
+{
+    let kernel = UmlsKernel::new(mesh);
+    let x = common::point_in(mesh, s, raw);
+    let mut st = Stencil::new();
+    kernel
+        .evaluate::<N, Linear>(mesh, s as u32, &x, gradient, &mut st)
+        .unwrap();
+    let h = mesh.max_edge_length();
+    let sum: f64 = st.values().iter().sum();
+    let grad_sum: SVector<f64, D> = st.gradients().iter().sum();
+    let mut moment = SVector::<f64, D>::zeros();
+    let mut jacobian = SMatrix::<f64, D, D>::zeros();
+    for (v, n, g) in st.iter() {
+        moment += mesh.vertex(v as usize) * n;
+        jacobian += mesh.vertex(v as usize) * g.transpose();
+    }
+    prop_assert!((sum - 1.0).abs() < 1e-12, "partition of unity: {}", sum);
+    prop_assert!(grad_sum.norm() * h < 1e-10, "gradient sum {:?}", grad_sum);
+    prop_assert!(
+        (moment - x).norm() < 1e-12 * (1.0 + x.norm()),
+        "linear reproduction {:?} vs {:?}",
+        moment,
+        x
+    );
+    prop_assert!(
+        (jacobian - SMatrix::<f64, D, D>::identity()).norm() < 1e-9,
+        "gradient reproduction {}",
+        jacobian
+    );
+    Ok(())
+}
+
+/// A fixed quadratic q(x) = Σ a_ij x_i x_j + b·x + c and its gradient.
+fn quadratic<const D: usize>(x: &SVector<f64, D>) -> (f64, SVector<f64, D>) {
+    let mut value = 0.7;
+    let mut grad = SVector::<f64, D>::zeros();
+    for i in 0..D {
+        value += (i as f64 + 1.0) * 0.3 * x[i];
+        grad[i] += (i as f64 + 1.0) * 0.3;
+        for j in i..D {
+            let a = 1.0 + 0.5 * i as f64 - 0.8 * j as f64;
+            value += a * x[i] * x[j];
+            grad[i] += a * x[j];
+            grad[j] += a * x[i];
+        }
+    }
+    (value, grad)
+}
+
+/// The quadratic basis reproduces quadratic fields: value and gradient.
+fn check_quadratic<const D: usize, const N: usize>(
+    mesh: &SimplexMesh<D>,
+    s: usize,
+    raw: &[f64],
+    gradient: GradientKind,
+) -> Result<(), TestCaseError>
+where
+    Quadratic: PolynomialBasis<D, N>,
+{
+    let kernel = UmlsKernel::new(mesh);
+    let x = common::point_in(mesh, s, raw);
+    let mut st = Stencil::new();
+    kernel
+        .evaluate::<N, Quadratic>(mesh, s as u32, &x, gradient, &mut st)
+        .unwrap();
+    let field: Vec<f64> = mesh.vertices().iter().map(|v| quadratic(v).0).collect();
+    let (value, grad) = st.interpolate(&field).unwrap();
+    let (exact, exact_grad) = quadratic(&x);
+    prop_assert!(
+        (value - exact).abs() < 1e-10,
+        "value {} vs {}",
+        value,
+        exact
+    );
+    prop_assert!(
+        (grad - exact_grad).norm() < 1e-8,
+        "gradient {:?} vs {:?}",
+        grad,
+        exact_grad
+    );
+    Ok(())
+}
+
+fn raw_weights() -> impl Strategy<Value = Vec<f64>> {
+    prop::collection::vec(0.001f64..1.0, 4)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn linear_reproduction_1d(mesh in common::interval(), s in any::<usize>(), raw in raw_weights()) {
+        let s = s % mesh.simplex_count();
+        check_linear::<1, 2>(&mesh, s, &raw, GradientKind::Reconstructed)?;
+        check_linear::<1, 2>(&mesh, s, &raw, GradientKind::Full)?;
+    }
+
+    #[test]
+    fn linear_reproduction_2d(mesh in common::rectangle(), s in any::<usize>(), raw in raw_weights()) {
+        let s = s % mesh.simplex_count();
+        check_linear::<2, 3>(&mesh, s, &raw, GradientKind::Reconstructed)?;
+        check_linear::<2, 3>(&mesh, s, &raw, GradientKind::Full)?;
+    }
+
+    #[test]
+    fn linear_reproduction_3d(mesh in common::cuboid(), s in any::<usize>(), raw in raw_weights()) {
+        let s = s % mesh.simplex_count();
+        check_linear::<3, 4>(&mesh, s, &raw, GradientKind::Reconstructed)?;
+        check_linear::<3, 4>(&mesh, s, &raw, GradientKind::Full)?;
+    }
+
+    /// Quadratic reproduction on hosts with complete 1-rings (boundary hosts can have too few
+    /// weighted samples for six or ten monomials; the conditioning tests cover those).
+    #[test]
+    fn quadratic_reproduction_1d(mesh in common::interval(), s in any::<usize>(), raw in raw_weights()) {
+        let interior = common::interior_simplices(&mesh);
+        let s = interior[s % interior.len()];
+        check_quadratic::<1, 3>(&mesh, s, &raw, GradientKind::Reconstructed)?;
+        check_quadratic::<1, 3>(&mesh, s, &raw, GradientKind::Full)?;
+    }
+
+    #[test]
+    fn quadratic_reproduction_2d(mesh in common::rectangle(), s in any::<usize>(), raw in raw_weights()) {
+        let interior = common::interior_simplices(&mesh);
+        let s = interior[s % interior.len()];
+        check_quadratic::<2, 6>(&mesh, s, &raw, GradientKind::Reconstructed)?;
+        check_quadratic::<2, 6>(&mesh, s, &raw, GradientKind::Full)?;
+    }
+
+    #[test]
+    fn quadratic_reproduction_3d(mesh in common::fine_cuboid(), s in any::<usize>(), raw in raw_weights()) {
+        let interior = common::interior_simplices(&mesh);
+        let s = interior[s % interior.len()];
+        check_quadratic::<3, 10>(&mesh, s, &raw, GradientKind::Reconstructed)?;
+        check_quadratic::<3, 10>(&mesh, s, &raw, GradientKind::Full)?;
+    }
+}

@@ -1,0 +1,25 @@
+//! UMLS-MPM: the material point method on unstructured simplicial meshes with
+//! C¹-continuous moving-least-squares kernels, and moving least squares on sampled
+//! manifolds.
+//!
+//! This facade re-exports the member crates so that one dependency gives the whole
+//! toolkit; each crate can also be used alone:
+//!
+//! - [`mesh`] (`umls-mesh`): simplicial meshes, topology, 1-rings, point location,
+//!   generators, quality;
+//! - [`mls`] (`umls-mls`): MLS generic over dimension and basis, and the UMLS kernel.
+//!
+//! ```
+//! use umls::mesh::generate::{Diagonal, Lattice};
+//! use umls::mls::{GradientKind, Linear, Stencil, UmlsKernel};
+//!
+//! let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [4, 4]).triangles(Diagonal::Right)?;
+//! let kernel = UmlsKernel::new(&mesh);
+//! let mut stencil = Stencil::new();
+//! kernel.evaluate::<3, Linear>(&mesh, 0, &mesh.centroid(0), GradientKind::Reconstructed, &mut stencil)?;
+//! assert!((stencil.values().iter().sum::<f64>() - 1.0).abs() < 1e-12);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub use umls_mesh as mesh;
+pub use umls_mls as mls;
