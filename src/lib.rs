@@ -7,7 +7,8 @@
 //!
 //! - [`mesh`] (`umls-mesh`): simplicial meshes, topology, 1-rings, point location,
 //!   generators, quality;
-//! - [`mls`] (`umls-mls`): MLS generic over dimension and basis, and the UMLS kernel.
+//! - [`mls`] (`umls-mls`): MLS generic over dimension and basis, and the UMLS kernel;
+//! - [`constitutive`] (`umls-constitutive`): elastic, fluid and elastoplastic material models.
 //!
 //! ```
 //! use umls::mesh::generate::{Diagonal, Lattice};
@@ -21,5 +22,6 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub use umls_constitutive as constitutive;
 pub use umls_mesh as mesh;
 pub use umls_mls as mls;

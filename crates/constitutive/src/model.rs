@@ -1,0 +1,73 @@
+//! The constitutive port: what the MPM engine asks of a material.
+
+use std::fmt::Debug;
+
+use crate::error::ConstitutiveError;
+use crate::linalg::{Matrix, inverse_transpose, positive_jacobian};
+
+/// A material model in D dimensions.
+///
+/// The engine keeps the total deformation gradient F per particle and one
+/// [`Self::State`]. Each step it updates F, calls [`Self::return_map`] (plastic models
+/// project onto the yield surface and update the state; elastic models do nothing), then
+/// asks for the Kirchhoff stress τ = Jσ, which the internal force f_i = −Σ_p V_p⁰ τ_p ∇N_i
+/// needs without a division by J.
+pub trait Constitutive<const D: usize>: Send + Sync + Debug {
+    /// Per-particle internal state (`()` for elastic models).
+    type State: Clone + Debug + PartialEq + Send + Sync;
+
+    /// A short name for messages.
+    fn name(&self) -> &'static str;
+
+    /// The state of undeformed, virgin material.
+    fn initial_state(&self) -> Self::State;
+
+    /// The explicit return-mapping step for total deformation `f`: updates `state` so that
+    /// the stress lies on or inside the yield surface. Elastic models: no-op.
+    fn return_map(&self, f: &Matrix<D>, state: &mut Self::State) -> Result<(), ConstitutiveError> {
+        let _ = (f, state);
+        Ok(())
+    }
+
+    /// Kirchhoff stress τ = J σ (symmetric).
+    fn kirchhoff_stress(
+        &self,
+        f: &Matrix<D>,
+        state: &Self::State,
+    ) -> Result<Matrix<D>, ConstitutiveError>;
+
+    /// Stored (elastic) energy per unit reference volume, ψ(F).
+    fn energy_density(&self, f: &Matrix<D>, state: &Self::State) -> Result<f64, ConstitutiveError>;
+
+    /// P-wave modulus λ + 2μ (the stiffness of longitudinal waves; E in 1D).
+    fn p_wave_modulus(&self) -> f64;
+
+    /// Cauchy stress σ = τ / J; needs det F > 0.
+    fn cauchy_stress(
+        &self,
+        f: &Matrix<D>,
+        state: &Self::State,
+    ) -> Result<Matrix<D>, ConstitutiveError> {
+        let det = positive_jacobian(self.name(), f)?;
+        Ok(self.kirchhoff_stress(f, state)? / det)
+    }
+
+    /// First Piola–Kirchhoff stress P = τ F⁻ᵀ; for hyperelastic models P = ∂ψ/∂F.
+    fn first_piola(
+        &self,
+        f: &Matrix<D>,
+        state: &Self::State,
+    ) -> Result<Matrix<D>, ConstitutiveError> {
+        let det = crate::linalg::determinant(f);
+        let inv_t = inverse_transpose(f).ok_or(ConstitutiveError::NonPositiveJacobian {
+            model: self.name(),
+            det,
+        })?;
+        Ok(self.kirchhoff_stress(f, state)? * inv_t)
+    }
+
+    /// Longitudinal wave speed √((λ + 2μ)/ρ) for the CFL bound.
+    fn p_wave_speed(&self, density: f64) -> f64 {
+        (self.p_wave_modulus() / density).sqrt()
+    }
+}
