@@ -8,7 +8,9 @@
 //! - [`mesh`] (`umls-mesh`): simplicial meshes, topology, 1-rings, point location,
 //!   generators, quality;
 //! - [`mls`] (`umls-mls`): MLS generic over dimension and basis, and the UMLS kernel;
-//! - [`constitutive`] (`umls-constitutive`): elastic, fluid and elastoplastic material models.
+//! - [`constitutive`] (`umls-constitutive`): elastic, fluid and elastoplastic material models;
+//! - [`manifold`] (`umls-manifold`): moving least squares on point clouds sampled near a
+//!   manifold in Rⁿ.
 //!
 //! ```
 //! use umls::mesh::generate::{Diagonal, Lattice};
@@ -23,5 +25,6 @@
 //! ```
 
 pub use umls_constitutive as constitutive;
+pub use umls_manifold as manifold;
 pub use umls_mesh as mesh;
 pub use umls_mls as mls;
