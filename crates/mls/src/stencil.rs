@@ -52,6 +52,36 @@ impl<const D: usize> Stencil<D> {
         }
     }
 
+    /// Empties the stencil for refilling with [`Self::push`].
+    #[inline]
+    pub fn clear(&mut self) {
+        self.len = 0;
+        self.condition = f64::NAN;
+    }
+
+    /// Appends a node with its shape function value and gradient (for kernels that do not
+    /// go through the MLS solve, such as finite elements and B-splines).
+    #[inline]
+    pub fn push(
+        &mut self,
+        node: u32,
+        value: f64,
+        gradient: SVector<f64, D>,
+    ) -> Result<(), MlsError> {
+        if self.len == MAX_STENCIL {
+            return Err(MlsError::StencilOverflow {
+                simplex: None,
+                samples: self.len + 1,
+                capacity: MAX_STENCIL,
+            });
+        }
+        self.nodes[self.len] = node;
+        self.values[self.len] = value;
+        self.gradients[self.len] = gradient;
+        self.len += 1;
+        Ok(())
+    }
+
     /// Number of nodes.
     #[inline]
     pub fn len(&self) -> usize {

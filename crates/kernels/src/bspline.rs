@@ -1,0 +1,185 @@
+//! Tensor-product B-spline shape functions on a Cartesian grid: the structured-grid
+//! reference of MPM.
+
+use nalgebra::SVector;
+use umls_transfer::{Kernel, KernelError, Stencil};
+
+/// Polynomial order of the B-spline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BSplineOrder {
+    /// Quadratic (C¹, 3 nodes per axis).
+    Quadratic,
+    /// Cubic (C², 4 nodes per axis).
+    Cubic,
+}
+
+impl BSplineOrder {
+    /// Nodes per axis in a stencil.
+    pub fn width(self) -> usize {
+        match self {
+            Self::Quadratic => 3,
+            Self::Cubic => 4,
+        }
+    }
+
+    /// First stencil node (in units of h) for the coordinate ξ = (x − origin)/h.
+    fn base(self, xi: f64) -> f64 {
+        match self {
+            Self::Quadratic => (xi - 0.5).floor(),
+            Self::Cubic => xi.floor() - 1.0,
+        }
+    }
+
+    /// N(r) and dN/dr for the distance r (in units of h) from a node.
+    fn weight(self, r: f64) -> (f64, f64) {
+        let a = r.abs();
+        let sign = r.signum();
+        match self {
+            Self::Quadratic => {
+                if a < 0.5 {
+                    (0.75 - a * a, -2.0 * r)
+                } else if a < 1.5 {
+                    let t = 1.5 - a;
+                    (0.5 * t * t, -sign * t)
+                } else {
+                    (0.0, 0.0)
+                }
+            }
+            Self::Cubic => {
+                if a < 1.0 {
+                    (
+                        0.5 * a * a * a - a * a + 2.0 / 3.0,
+                        sign * (1.5 * a * a - 2.0 * a),
+                    )
+                } else if a < 2.0 {
+                    let t = 2.0 - a;
+                    (t * t * t / 6.0, -sign * 0.5 * t * t)
+                } else {
+                    (0.0, 0.0)
+                }
+            }
+        }
+    }
+}
+
+/// B-spline kernel on the grid `origin + h·(i₀, …, i_{D−1})`, `0 ≤ i_k ≤ cells[k]`.
+///
+/// Node index `i₀ + (n₀+1)(i₁ + (n₁+1) i₂)`. A point's stencil must lie inside the grid:
+/// for quadratic splines that is ξ_k ∈ [0.5, n_k − 0.5], for cubic ξ_k ∈ [1, n_k − 1]
+/// (ξ = (x − origin)/h); pad the grid by one or two cells around the material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BSplineKernel<const D: usize> {
+    origin: SVector<f64, D>,
+    h: f64,
+    cells: [usize; D],
+    order: BSplineOrder,
+}
+
+impl<const D: usize> BSplineKernel<D> {
+    /// A grid of `cells` cells of size `h` from `origin`; `None` for h ≤ 0 or too few cells
+    /// for one stencil.
+    pub fn new(
+        origin: SVector<f64, D>,
+        h: f64,
+        cells: [usize; D],
+        order: BSplineOrder,
+    ) -> Option<Self> {
+        let ok = h.is_finite() && h > 0.0 && cells.iter().all(|&n| n + 1 >= order.width());
+        ok.then_some(Self {
+            origin,
+            h,
+            cells,
+            order,
+        })
+    }
+
+    /// The spline order.
+    pub fn order(&self) -> BSplineOrder {
+        self.order
+    }
+
+    fn node_index(&self, ijk: [usize; D]) -> usize {
+        let mut index = 0;
+        for k in (0..D).rev() {
+            index = index * (self.cells[k] + 1) + ijk[k];
+        }
+        index
+    }
+}
+
+impl<const D: usize> Kernel<D> for BSplineKernel<D> {
+    type Cache = ();
+
+    fn node_count(&self) -> usize {
+        self.cells.iter().map(|n| n + 1).product()
+    }
+
+    fn node_position(&self, node: usize) -> SVector<f64, D> {
+        let mut rest = node;
+        SVector::<f64, D>::from_fn(|k, _| {
+            let i = rest % (self.cells[k] + 1);
+            rest /= self.cells[k] + 1;
+            self.origin[k] + self.h * i as f64
+        })
+    }
+
+    fn spacing(&self) -> f64 {
+        self.h
+    }
+
+    fn stencil(
+        &self,
+        x: &SVector<f64, D>,
+        _: &mut (),
+        out: &mut Stencil<D>,
+    ) -> Result<(), KernelError> {
+        let width = self.order.width();
+        let mut base = [0usize; D];
+        // Per axis: weights and derivatives of the `width` nodes.
+        let mut w = [[0.0; 4]; D];
+        let mut dw = [[0.0; 4]; D];
+        for k in 0..D {
+            let xi = (x[k] - self.origin[k]) / self.h;
+            let b = self.order.base(xi);
+            if !(b >= 0.0 && b + (width - 1) as f64 <= self.cells[k] as f64) {
+                return Err(KernelError::OutsideDomain {
+                    point: x.iter().copied().collect(),
+                });
+            }
+            base[k] = b as usize;
+            for a in 0..width {
+                let (value, derivative) = self.order.weight(xi - (b + a as f64));
+                w[k][a] = value;
+                dw[k][a] = derivative / self.h;
+            }
+        }
+        out.clear();
+        let count = width.pow(D as u32);
+        for flat in 0..count {
+            let mut offsets = [0usize; D];
+            let mut rest = flat;
+            for o in offsets.iter_mut() {
+                *o = rest % width;
+                rest /= width;
+            }
+            let mut value = 1.0;
+            for k in 0..D {
+                value *= w[k][offsets[k]];
+            }
+            let gradient = SVector::<f64, D>::from_fn(|j, _| {
+                (0..D)
+                    .map(|k| {
+                        if k == j {
+                            dw[k][offsets[k]]
+                        } else {
+                            w[k][offsets[k]]
+                        }
+                    })
+                    .product()
+            });
+            let node = self.node_index(std::array::from_fn(|k| base[k] + offsets[k]));
+            out.push(node as u32, value, gradient)?;
+        }
+        Ok(())
+    }
+}

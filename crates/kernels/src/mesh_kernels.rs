@@ -1,0 +1,152 @@
+//! Kernels on simplicial meshes: UMLS and linear finite elements.
+
+use std::sync::Arc;
+
+use nalgebra::SVector;
+use umls_mesh::SimplexMesh;
+use umls_mls::{GradientKind, Linear, PolynomialBasis, UmlsKernel};
+use umls_transfer::{Kernel, KernelError, Stencil};
+
+/// The host simplex a particle was last found in (`None` before the first location).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct HostCache(pub Option<u32>);
+
+/// Locates `x` walking from the cached host (BVH on the first call) and updates the cache.
+fn locate<const D: usize>(
+    mesh: &SimplexMesh<D>,
+    x: &SVector<f64, D>,
+    cache: &mut HostCache,
+) -> Result<u32, KernelError> {
+    let found = match cache.0 {
+        Some(host) => mesh.locate_from(x, host),
+        None => mesh.locate(x),
+    }
+    .ok_or_else(|| KernelError::OutsideDomain {
+        point: x.iter().copied().collect(),
+    })?;
+    cache.0 = Some(found.simplex);
+    Ok(found.simplex)
+}
+
+/// The UMLS kernel (C¹ diminishing-weight MLS over the host's 1-ring, linear basis,
+/// reconstructed gradient) as an MPM kernel. Nodes are the mesh vertices.
+///
+/// `N` is the linear basis size D + 1; use the aliases [`Umls1`], [`Umls2`], [`Umls3`].
+#[derive(Debug, Clone)]
+pub struct UmlsMeshKernel<const D: usize, const N: usize> {
+    mesh: Arc<SimplexMesh<D>>,
+    kernel: UmlsKernel<D>,
+}
+
+/// UMLS on segments.
+pub type Umls1 = UmlsMeshKernel<1, 2>;
+/// UMLS on triangles.
+pub type Umls2 = UmlsMeshKernel<2, 3>;
+/// UMLS on tetrahedra.
+pub type Umls3 = UmlsMeshKernel<3, 4>;
+
+impl<const D: usize, const N: usize> UmlsMeshKernel<D, N> {
+    /// The paper's kernel (cubic B-spline distance weights, per-vertex radii) on `mesh`.
+    pub fn new(mesh: Arc<SimplexMesh<D>>) -> Self {
+        let kernel = UmlsKernel::new(&mesh);
+        Self { mesh, kernel }
+    }
+
+    /// A kernel with custom MLS settings (weights, radii, conditioning) built for `mesh`.
+    pub fn with_kernel(mesh: Arc<SimplexMesh<D>>, kernel: UmlsKernel<D>) -> Self {
+        Self { mesh, kernel }
+    }
+
+    /// The mesh.
+    pub fn mesh(&self) -> &Arc<SimplexMesh<D>> {
+        &self.mesh
+    }
+}
+
+impl<const D: usize, const N: usize> Kernel<D> for UmlsMeshKernel<D, N>
+where
+    Linear: PolynomialBasis<D, N>,
+{
+    type Cache = HostCache;
+
+    fn node_count(&self) -> usize {
+        self.mesh.vertex_count()
+    }
+
+    fn node_position(&self, node: usize) -> SVector<f64, D> {
+        *self.mesh.vertex(node)
+    }
+
+    fn spacing(&self) -> f64 {
+        self.mesh.min_edge_length()
+    }
+
+    fn stencil(
+        &self,
+        x: &SVector<f64, D>,
+        cache: &mut HostCache,
+        out: &mut Stencil<D>,
+    ) -> Result<(), KernelError> {
+        let host = locate(&self.mesh, x, cache)?;
+        self.kernel
+            .evaluate::<N, Linear>(&self.mesh, host, x, GradientKind::Reconstructed, out)?;
+        Ok(())
+    }
+}
+
+/// Linear (P1) finite-element shape functions on the host simplex: the classic
+/// unstructured MPM, whose gradients jump across facets (cell-crossing error).
+#[derive(Debug, Clone)]
+pub struct LinearFeKernel<const D: usize> {
+    mesh: Arc<SimplexMesh<D>>,
+}
+
+impl<const D: usize> LinearFeKernel<D> {
+    /// P1 shape functions on `mesh`.
+    pub fn new(mesh: Arc<SimplexMesh<D>>) -> Self {
+        Self { mesh }
+    }
+
+    /// The mesh.
+    pub fn mesh(&self) -> &Arc<SimplexMesh<D>> {
+        &self.mesh
+    }
+}
+
+impl<const D: usize> Kernel<D> for LinearFeKernel<D> {
+    type Cache = HostCache;
+
+    fn node_count(&self) -> usize {
+        self.mesh.vertex_count()
+    }
+
+    fn node_position(&self, node: usize) -> SVector<f64, D> {
+        *self.mesh.vertex(node)
+    }
+
+    fn spacing(&self) -> f64 {
+        self.mesh.min_edge_length()
+    }
+
+    fn stencil(
+        &self,
+        x: &SVector<f64, D>,
+        cache: &mut HostCache,
+        out: &mut Stencil<D>,
+    ) -> Result<(), KernelError> {
+        let host = locate(&self.mesh, x, cache)? as usize;
+        let lambda = self.mesh.barycentric(host, x);
+        let gradients = self.mesh.barycentric_gradients(host);
+        out.clear();
+        for ((&v, &l), g) in self
+            .mesh
+            .simplex(host)
+            .iter()
+            .zip(lambda.as_slice())
+            .zip(gradients.as_slice())
+        {
+            out.push(v, l, *g)?;
+        }
+        Ok(())
+    }
+}

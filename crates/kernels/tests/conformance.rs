@@ -1,0 +1,151 @@
+//! The conformance suite every kernel must pass: partition of unity, linear reproduction
+//! of values and gradients, valid node indices, results independent of the location
+//! cache, and a typed error outside the domain. Plus kernel-specific checks.
+
+use std::sync::Arc;
+
+use nalgebra::{SMatrix, SVector};
+use proptest::prelude::*;
+use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, Umls1, Umls2, Umls3};
+use umls_mesh::generate::{Diagonal, Lattice};
+use umls_transfer::{Kernel, KernelError, Stencil};
+
+/// Runs the suite on points given as fractions of the box [lo, hi].
+fn conformance<const D: usize, K: Kernel<D>>(
+    kernel: &K,
+    lo: SVector<f64, D>,
+    hi: SVector<f64, D>,
+    fractions: &[f64],
+) -> Result<(), TestCaseError> {
+    let mut cache = K::Cache::default();
+    let mut st = Stencil::new();
+    let mut fresh = Stencil::new();
+    for chunk in fractions.chunks_exact(D) {
+        let x = lo + SVector::<f64, D>::from_fn(|k, _| chunk[k] * (hi[k] - lo[k]));
+        kernel.stencil(&x, &mut cache, &mut st).unwrap();
+        let sum: f64 = st.values().iter().sum();
+        let grad_sum: SVector<f64, D> = st.gradients().iter().sum();
+        let mut position = SVector::<f64, D>::zeros();
+        let mut jacobian = SMatrix::<f64, D, D>::zeros();
+        for (node, n, g) in st.iter() {
+            prop_assert!((node as usize) < kernel.node_count());
+            let xi = kernel.node_position(node as usize);
+            position += xi * n;
+            jacobian += xi * g.transpose();
+        }
+        let h = kernel.spacing();
+        prop_assert!((sum - 1.0).abs() < 1e-12, "partition of unity {}", sum);
+        prop_assert!(grad_sum.norm() * h < 1e-10, "Σ∇N = {:?}", grad_sum);
+        prop_assert!(
+            (position - x).norm() < 1e-12 * (1.0 + x.norm()),
+            "Σ N x = {:?} vs {:?}",
+            position,
+            x
+        );
+        prop_assert!(
+            (jacobian - SMatrix::<f64, D, D>::identity()).norm() < 1e-9,
+            "Σ x ∇Nᵀ = {}",
+            jacobian
+        );
+        // The cache only speeds location up: a fresh cache gives the same stencil.
+        kernel
+            .stencil(&x, &mut K::Cache::default(), &mut fresh)
+            .unwrap();
+        prop_assert_eq!(st.nodes(), fresh.nodes());
+        prop_assert_eq!(st.values(), fresh.values());
+    }
+    let outside = hi + SVector::<f64, D>::repeat(10.0 * kernel.spacing() + 1.0);
+    let outside_error = matches!(
+        kernel.stencil(&outside, &mut K::Cache::default(), &mut st),
+        Err(KernelError::OutsideDomain { .. })
+    );
+    prop_assert!(outside_error);
+    Ok(())
+}
+
+fn fractions(d: usize) -> impl Strategy<Value = Vec<f64>> {
+    prop::collection::vec(0.0f64..1.0, 12 * d)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    #[test]
+    fn mesh_kernels_1d(f in fractions(1), seed in any::<u64>()) {
+        let mesh = Arc::new(Lattice::new([0.0], [2.0], [16]).jitter(0.2, seed).segments().unwrap());
+        let (lo, hi) = mesh.bounding_box();
+        conformance(&Umls1::new(mesh.clone()), lo, hi, &f)?;
+        conformance(&LinearFeKernel::new(mesh), lo, hi, &f)?;
+    }
+
+    #[test]
+    fn mesh_kernels_2d(f in fractions(2), seed in any::<u64>(), angle in 0.0f64..6.3) {
+        let mesh = Arc::new(Lattice::new([0.0, 0.0], [1.0, 1.0], [9, 7]).jitter(0.2, seed).triangles(Diagonal::Alternating).unwrap());
+        // Fractions of the unrotated square, rotated with the mesh.
+        let rotation = nalgebra::Rotation2::new(angle);
+        let rotated = Arc::new(Lattice::new([0.0, 0.0], [1.0, 1.0], [9, 7]).jitter(0.2, seed).rotate_by(angle).triangles(Diagonal::Alternating).unwrap());
+        let centre = SVector::<f64, 2>::new(0.5, 0.5);
+        let (lo, hi) = (SVector::<f64, 2>::zeros(), SVector::<f64, 2>::repeat(1.0));
+        conformance(&Umls2::new(mesh.clone()), lo, hi, &f)?;
+        conformance(&LinearFeKernel::new(mesh), lo, hi, &f)?;
+        // Same points mapped into the rotated square.
+        let mapped: Vec<f64> = f.chunks_exact(2).flat_map(|c| {
+            let p = centre + rotation * (SVector::<f64, 2>::new(c[0], c[1]) - centre);
+            let (rlo, rhi) = rotated.bounding_box();
+            [(p.x - rlo.x) / (rhi.x - rlo.x), (p.y - rlo.y) / (rhi.y - rlo.y)]
+        }).collect();
+        let (rlo, rhi) = rotated.bounding_box();
+        conformance(&Umls2::new(rotated.clone()), rlo, rhi, &mapped)?;
+    }
+
+    #[test]
+    fn mesh_kernels_3d(f in fractions(3), seed in any::<u64>()) {
+        let mesh = Arc::new(Lattice::new([0.0; 3], [1.0; 3], [4, 4, 4]).jitter(0.2, seed).tetrahedra().unwrap());
+        let (lo, hi) = mesh.bounding_box();
+        conformance(&Umls3::new(mesh.clone()), lo, hi, &f)?;
+        conformance(&LinearFeKernel::new(mesh), lo, hi, &f)?;
+    }
+
+    #[test]
+    fn bspline_kernels(f1 in fractions(1), f2 in fractions(2), f3 in fractions(3)) {
+        for order in [BSplineOrder::Quadratic, BSplineOrder::Cubic] {
+            // Valid region: one (quadratic: half) cell inside the grid; test the inner box.
+            let k1 = BSplineKernel::new(SVector::from([0.0]), 0.1, [20], order).unwrap();
+            conformance(&k1, SVector::from([0.1]), SVector::from([1.9]), &f1)?;
+            let k2 = BSplineKernel::new(SVector::from([-1.0, 0.0]), 0.25, [12, 8], order).unwrap();
+            conformance(&k2, SVector::from([-0.75, 0.25]), SVector::from([1.75, 1.75]), &f2)?;
+            let k3 = BSplineKernel::new(SVector::from([0.0, 0.0, 0.0]), 0.5, [6, 5, 4], order).unwrap();
+            conformance(&k3, SVector::from([0.5, 0.5, 0.5]), SVector::from([2.5, 2.0, 1.5]), &f3)?;
+        }
+    }
+}
+
+/// B-spline gradients are the derivatives of the values (central differences), and the
+/// stencil sizes are 3^D and 4^D.
+#[test]
+fn bspline_gradients_and_sizes() {
+    for order in [BSplineOrder::Quadratic, BSplineOrder::Cubic] {
+        let k = BSplineKernel::new(SVector::from([0.0, 0.0]), 0.2, [10, 10], order).unwrap();
+        let x = SVector::<f64, 2>::new(0.913, 1.071);
+        let (mut st, mut plus, mut minus) = (Stencil::new(), Stencil::new(), Stencil::new());
+        k.stencil(&x, &mut (), &mut st).unwrap();
+        assert_eq!(st.len(), order.width().pow(2));
+        let d = 1e-6;
+        for axis in 0..2 {
+            let e = SVector::<f64, 2>::from_fn(|i, _| if i == axis { d } else { 0.0 });
+            k.stencil(&(x + e), &mut (), &mut plus).unwrap();
+            k.stencil(&(x - e), &mut (), &mut minus).unwrap();
+            assert_eq!(plus.nodes(), st.nodes());
+            for i in 0..st.len() {
+                let fd = (plus.values()[i] - minus.values()[i]) / (2.0 * d);
+                assert!(
+                    (fd - st.gradients()[i][axis]).abs() < 1e-6,
+                    "{order:?} node {i}: {fd} vs {}",
+                    st.gradients()[i][axis]
+                );
+            }
+        }
+    }
+    assert!(BSplineKernel::new(SVector::from([0.0]), -1.0, [10], BSplineOrder::Cubic).is_none());
+    assert!(BSplineKernel::new(SVector::from([0.0]), 1.0, [2], BSplineOrder::Cubic).is_none());
+}

@@ -1,0 +1,74 @@
+//! The port between MPM particle-grid transfers and shape-function kernels.
+//!
+//! A [`Kernel`] owns a set of grid nodes (mesh vertices or Cartesian grid nodes) and, for
+//! a particle position, fills a [`Stencil`]: node indices, shape function values N_i and
+//! gradients ∇N_i. Each particle keeps a small [`Kernel::Cache`] (its host simplex or
+//! cell) so that relocating a particle that moved a little costs O(1). Transfers (P2G,
+//! G2P) and the engine see only this trait, so swapping UMLS for linear FE or B-splines
+//! changes one type.
+//!
+//! ```
+//! use nalgebra::SVector;
+//! use umls_transfer::{Kernel, KernelError, Stencil};
+//!
+//! /// Linear hat functions on the unit interval with two nodes: the smallest kernel.
+//! struct Hat;
+//! impl Kernel<1> for Hat {
+//!     type Cache = ();
+//!     fn node_count(&self) -> usize { 2 }
+//!     fn node_position(&self, node: usize) -> SVector<f64, 1> { SVector::from([node as f64]) }
+//!     fn spacing(&self) -> f64 { 1.0 }
+//!     fn stencil(&self, x: &SVector<f64, 1>, _: &mut (), out: &mut Stencil<1>) -> Result<(), KernelError> {
+//!         if !(0.0..=1.0).contains(&x[0]) { return Err(KernelError::OutsideDomain { point: vec![x[0]] }); }
+//!         out.clear();
+//!         out.push(0, 1.0 - x[0], SVector::from([-1.0]))?;
+//!         out.push(1, x[0], SVector::from([1.0]))?;
+//!         Ok(())
+//!     }
+//! }
+//! let mut st = Stencil::new();
+//! Hat.stencil(&SVector::from([0.25]), &mut (), &mut st)?;
+//! assert_eq!(st.values(), &[0.75, 0.25]);
+//! # Ok::<(), KernelError>(())
+//! ```
+
+use nalgebra::SVector;
+use thiserror::Error;
+pub use umls_mls::{MAX_STENCIL, MlsError, Stencil};
+
+/// Why a kernel could not produce a stencil.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum KernelError {
+    /// The point lies outside the kernel's domain (mesh or grid).
+    #[error("point {point:?} is outside the kernel's domain")]
+    OutsideDomain {
+        /// Coordinates of the point.
+        point: Vec<f64>,
+    },
+    /// The MLS evaluation failed (ill-conditioned moment matrix, stencil overflow, …).
+    #[error(transparent)]
+    Mls(#[from] MlsError),
+}
+
+/// A shape-function kernel over a fixed set of nodes.
+pub trait Kernel<const D: usize>: Send + Sync {
+    /// Per-particle location cache (host simplex, grid cell, or `()`).
+    type Cache: Copy + Default + Send + Sync + std::fmt::Debug;
+
+    /// Number of nodes.
+    fn node_count(&self) -> usize;
+
+    /// Position of node `node`.
+    fn node_position(&self, node: usize) -> SVector<f64, D>;
+
+    /// Characteristic node spacing h (shortest edge, or grid spacing), for the CFL bound.
+    fn spacing(&self) -> f64;
+
+    /// Fills `out` with the stencil at `x`, using and updating `cache`.
+    fn stencil(
+        &self,
+        x: &SVector<f64, D>,
+        cache: &mut Self::Cache,
+        out: &mut Stencil<D>,
+    ) -> Result<(), KernelError>;
+}
