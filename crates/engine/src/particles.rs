@@ -1,0 +1,58 @@
+//! Particle state, structure of arrays.
+
+use nalgebra::{SMatrix, SVector};
+
+/// The material points: positions, velocities, affine matrices, deformation gradients,
+/// reference volumes, masses, per-particle material state and kernel location cache.
+#[derive(Debug, Clone)]
+pub struct Particles<const D: usize, S, C> {
+    /// Positions x_p.
+    pub position: Vec<SVector<f64, D>>,
+    /// Velocities v_p.
+    pub velocity: Vec<SVector<f64, D>>,
+    /// Affine velocity matrices C_p (APIC / affine transfers; zero for PIC and FLIP).
+    pub affine: Vec<SMatrix<f64, D, D>>,
+    /// Deformation gradients F_p.
+    pub deformation: Vec<SMatrix<f64, D, D>>,
+    /// Reference volumes V_p⁰.
+    pub volume: Vec<f64>,
+    /// Masses m_p.
+    pub mass: Vec<f64>,
+    /// Material state (plastic variables).
+    pub state: Vec<S>,
+    /// Kernel location cache (host simplex or cell).
+    pub cache: Vec<C>,
+}
+
+impl<const D: usize, S: Clone, C: Copy + Default> Particles<D, S, C> {
+    /// Particles at rest at `positions` with reference volumes `volumes`, density `density`
+    /// and the material's initial state.
+    pub fn at_rest(
+        positions: Vec<SVector<f64, D>>,
+        volumes: Vec<f64>,
+        density: f64,
+        state: S,
+    ) -> Self {
+        let n = positions.len();
+        Self {
+            velocity: vec![SVector::zeros(); n],
+            affine: vec![SMatrix::zeros(); n],
+            deformation: vec![SMatrix::identity(); n],
+            mass: volumes.iter().map(|v| v * density).collect(),
+            volume: volumes,
+            state: vec![state; n],
+            cache: vec![C::default(); n],
+            position: positions,
+        }
+    }
+
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+
+    /// Whether there are no particles.
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+}
