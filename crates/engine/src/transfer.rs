@@ -44,6 +44,11 @@ pub struct Flip {
 
 /// Affine PIC (Jiang et al. 2015): C_p = B_p D_p⁻¹, with B_p and D_p summed over the
 /// stencil so the scheme holds for any kernel (D_p is not the B-spline closed form).
+///
+/// For hat functions D_p vanishes as a particle approaches a vertex (all weight on one
+/// node), and B_p D_p⁻¹ would explode; where D_p is ill-conditioned
+/// (det D_p < 10⁻⁶ (tr D_p / D)^D) the scheme uses the velocity gradient, which is what
+/// B_p D_p⁻¹ tends to for linear shape functions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Apic;
 
@@ -117,7 +122,11 @@ impl TransferScheme for Apic {
         d: &SMatrix<f64, D, D>,
         grad_v: &SMatrix<f64, D, D>,
     ) -> SMatrix<f64, D, D> {
-        // D_p is SPD for any stencil that spans D dimensions; fall back to ∇v otherwise.
+        let scale = (d.trace() / D as f64).powi(D as i32);
+        let det = umls_constitutive::determinant(d);
+        if det.is_nan() || det <= 1e-6 * scale {
+            return *grad_v;
+        }
         d.try_inverse().map_or(*grad_v, |inv| b * inv)
     }
 }
@@ -154,4 +163,36 @@ pub enum StressUpdate {
     /// Modified USL: after G2P, map the new particle momenta back to the grid and use
     /// that grid velocity for the deformation update (Sulsky et al. 1995).
     Musl,
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Matrix2;
+
+    use super::*;
+
+    #[test]
+    fn apic_recovers_affine_fields_and_falls_back_on_singular_d() {
+        // Nodes around a particle at 0 with N = 1/4 each: D = Σ N r rᵀ, B = Σ N (A r) rᵀ.
+        let a = Matrix2::new(0.3, -1.2, 0.7, 0.1);
+        let offsets = [(-1.0, -0.5), (1.0, -0.5), (0.5, 1.0), (-0.5, 1.0)];
+        let (mut b, mut d) = (Matrix2::zeros(), Matrix2::zeros());
+        for (x, y) in offsets {
+            let r = nalgebra::Vector2::new(x, y);
+            b += a * r * r.transpose() * 0.25;
+            d += r * r.transpose() * 0.25;
+        }
+        let grad_v = Matrix2::new(9.0, 9.0, 9.0, 9.0);
+        assert!((Apic.affine(&b, &d, &grad_v) - a).norm() < 1e-12);
+        // All weight on one node: D = 0 → the velocity gradient, not an explosion.
+        assert_eq!(Apic.affine(&b, &Matrix2::zeros(), &grad_v), grad_v);
+        assert_eq!(Pic.affine(&b, &d, &grad_v), Matrix2::zeros());
+        assert_eq!(VelocityGradientAffine.affine(&b, &d, &grad_v), grad_v);
+        let v = Flip { alpha: 0.75 }.velocity(
+            &nalgebra::Vector2::new(1.0, 0.0),
+            &nalgebra::Vector2::new(0.0, 2.0),
+            &nalgebra::Vector2::new(0.5, 0.5),
+        );
+        assert!((v - nalgebra::Vector2::new(1.125, 0.875)).norm() < 1e-15);
+    }
 }
