@@ -10,7 +10,10 @@
 //! - [`mls`] (`umls-mls`): MLS generic over dimension and basis, and the UMLS kernel;
 //! - [`constitutive`] (`umls-constitutive`): elastic, fluid and elastoplastic material models;
 //! - [`manifold`] (`umls-manifold`): moving least squares on point clouds sampled near a
-//!   manifold in Rⁿ.
+//!   manifold in Rⁿ;
+//! - [`transfer`] (`umls-transfer`), [`kernels`] (`umls-kernels`), [`engine`]
+//!   (`umls-engine`): the kernel port, the UMLS / linear-FE / B-spline kernels, and the
+//!   explicit MPM engine.
 //!
 //! ```
 //! use umls::mesh::generate::{Diagonal, Lattice};
@@ -25,6 +28,9 @@
 //! ```
 
 pub use umls_constitutive as constitutive;
+pub use umls_engine as engine;
+pub use umls_kernels as kernels;
 pub use umls_manifold as manifold;
 pub use umls_mesh as mesh;
 pub use umls_mls as mls;
+pub use umls_transfer as transfer;
