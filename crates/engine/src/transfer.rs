@@ -13,22 +13,28 @@ pub trait TransferScheme: Copy + Send + Sync + std::fmt::Debug {
     fn name(&self) -> &'static str;
 
     /// New particle velocity from its old value, the PIC value Σ N ṽ_i and the FLIP
-    /// increment Σ N (ṽ_i − v_i).
+    /// increment Σ N (ṽ_i − v_i). Default: the PIC value.
     fn velocity<const D: usize>(
         &self,
         old: &SVector<f64, D>,
         pic: &SVector<f64, D>,
         flip_increment: &SVector<f64, D>,
-    ) -> SVector<f64, D>;
+    ) -> SVector<f64, D> {
+        let _ = (old, flip_increment);
+        *pic
+    }
 
     /// New affine matrix from B_p = Σ N ṽ_i (x_i − x_p)ᵀ, D_p = Σ N (x_i − x_p)(x_i − x_p)ᵀ
-    /// and the velocity gradient ∇v_p = Σ ṽ_i ∇N_iᵀ. Non-affine schemes return zero.
+    /// and the velocity gradient ∇v_p = Σ ṽ_i ∇N_iᵀ. Default (non-affine schemes): zero.
     fn affine<const D: usize>(
         &self,
         b: &SMatrix<f64, D, D>,
         d: &SMatrix<f64, D, D>,
         grad_v: &SMatrix<f64, D, D>,
-    ) -> SMatrix<f64, D, D>;
+    ) -> SMatrix<f64, D, D> {
+        let _ = (b, d, grad_v);
+        SMatrix::zeros()
+    }
 }
 
 /// Particle-in-cell: v_p = Σ N ṽ_i (dissipative, stable).
@@ -62,22 +68,6 @@ impl TransferScheme for Pic {
     fn name(&self) -> &'static str {
         "PIC"
     }
-    fn velocity<const D: usize>(
-        &self,
-        _: &SVector<f64, D>,
-        pic: &SVector<f64, D>,
-        _: &SVector<f64, D>,
-    ) -> SVector<f64, D> {
-        *pic
-    }
-    fn affine<const D: usize>(
-        &self,
-        _: &SMatrix<f64, D, D>,
-        _: &SMatrix<f64, D, D>,
-        _: &SMatrix<f64, D, D>,
-    ) -> SMatrix<f64, D, D> {
-        SMatrix::zeros()
-    }
 }
 
 impl TransferScheme for Flip {
@@ -93,28 +83,12 @@ impl TransferScheme for Flip {
     ) -> SVector<f64, D> {
         (old + flip_increment) * self.alpha + pic * (1.0 - self.alpha)
     }
-    fn affine<const D: usize>(
-        &self,
-        _: &SMatrix<f64, D, D>,
-        _: &SMatrix<f64, D, D>,
-        _: &SMatrix<f64, D, D>,
-    ) -> SMatrix<f64, D, D> {
-        SMatrix::zeros()
-    }
 }
 
 impl TransferScheme for Apic {
     const AFFINE: bool = true;
     fn name(&self) -> &'static str {
         "APIC"
-    }
-    fn velocity<const D: usize>(
-        &self,
-        _: &SVector<f64, D>,
-        pic: &SVector<f64, D>,
-        _: &SVector<f64, D>,
-    ) -> SVector<f64, D> {
-        *pic
     }
     fn affine<const D: usize>(
         &self,
@@ -135,14 +109,6 @@ impl TransferScheme for VelocityGradientAffine {
     const AFFINE: bool = true;
     fn name(&self) -> &'static str {
         "affine (velocity gradient)"
-    }
-    fn velocity<const D: usize>(
-        &self,
-        _: &SVector<f64, D>,
-        pic: &SVector<f64, D>,
-        _: &SVector<f64, D>,
-    ) -> SVector<f64, D> {
-        *pic
     }
     fn affine<const D: usize>(
         &self,
