@@ -12,50 +12,16 @@
 //! radius 0.2 at (0.2, 0.2) and (0.8, 0.8) moving at ±(0.1, 0.1), linear elastic
 //! E = 1000, ν = 0.3, ρ = 1000, 4 particles per 0.05² cell, FLIP 0.99, Δt = 10⁻³, T = 3.
 
+use nalgebra::Vector2;
+use plotters::prelude::*;
 use std::error::Error;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
-
-use nalgebra::Vector2;
-use plotters::prelude::*;
-use umls::constitutive::{ElasticParameters, LinearElastic};
-use umls::engine::{Diagnostics, Flip, Particles, Simulation, StepSettings};
-use umls::kernels::{HostCache, LinearFeKernel, Umls2};
-use umls::mesh::SimplexMesh;
-use umls::mesh::generate::{Diagonal, Lattice};
+use umls::constitutive::LinearElastic;
+use umls::engine::{Diagnostics, Flip, Simulation};
+use umls::kernels::{LinearFeKernel, Umls2};
+use umls::scenes::colliding_disks::CollidingDisks;
 use umls::transfer::Kernel;
-
-const END: f64 = 3.0;
-const DT: f64 = 1e-3;
-
-fn disks() -> Particles<2, (), HostCache> {
-    let spacing = 0.025;
-    let mut x = Vec::new();
-    let mut v = Vec::new();
-    for (centre, velocity) in [
-        (Vector2::new(0.2, 0.2), Vector2::new(0.1, 0.1)),
-        (Vector2::new(0.8, 0.8), Vector2::new(-0.1, -0.1)),
-    ] {
-        for i in 0..16 {
-            for j in 0..16 {
-                let p = centre
-                    + Vector2::new(
-                        -0.2 + (i as f64 + 0.5) * spacing,
-                        -0.2 + (j as f64 + 0.5) * spacing,
-                    );
-                if (p - centre).norm() < 0.2 {
-                    x.push(p);
-                    v.push(velocity);
-                }
-            }
-        }
-    }
-    let n = x.len();
-    let mut particles = Particles::at_rest(x, vec![spacing * spacing; n], 1000.0, ());
-    particles.velocity = v;
-    particles
-}
 
 /// Energy history every 10 steps and the mean-stress history of one particle.
 struct Run {
@@ -64,21 +30,16 @@ struct Run {
     wall: f64,
 }
 
-fn run<K: Kernel<2, Cache = HostCache>>(kernel: K, tracer: usize) -> Result<Run, Box<dyn Error>> {
-    let material = LinearElastic {
-        parameters: ElasticParameters::from_young_poisson(1000.0, 0.3)?,
-    };
-    let mut sim = Simulation::new(
-        kernel,
-        material,
-        Flip { alpha: 0.99 },
-        disks(),
-        StepSettings::new(DT),
-    )?;
+fn run<K: Kernel<2>>(
+    scene: &CollidingDisks,
+    kernel: K,
+    tracer: usize,
+) -> Result<Run, Box<dyn Error>> {
+    let mut sim = scene.simulation(kernel, Flip { alpha: 0.99 })?;
     let start = std::time::Instant::now();
     let mut history = vec![sim.diagnostics()?];
     let mut trace = Vec::new();
-    while sim.time() < END - 1e-9 {
+    while sim.time() < scene.end_time - 1e-9 {
         sim.step()?;
         let tau = sim.material_stress(tracer)?;
         trace.push((sim.time(), 0.5 * tau.trace()));
@@ -143,14 +104,11 @@ fn main() -> Result<(), Box<dyn Error>> {
             .unwrap_or_else(|| "out/colliding-disks".into()),
     );
     std::fs::create_dir_all(&out)?;
-    let mesh: Arc<SimplexMesh<2>> = Arc::new(
-        Lattice::new([0.0, 0.0], [1.0, 1.0], [20, 20])
-            .jitter(0.2, 11)
-            .triangles(Diagonal::Alternating)?,
-    );
+    let scene = CollidingDisks::default();
+    let mesh = scene.shared_mesh()?;
     // The particle nearest the contact point of the first disk: it crosses facets while
     // carrying the largest stresses.
-    let particles = disks();
+    let particles = scene.particles::<()>();
     let tracer = (0..particles.len() / 2)
         .min_by(|&a, &b| {
             (particles.position[a] - Vector2::new(0.33, 0.33))
@@ -159,12 +117,14 @@ fn main() -> Result<(), Box<dyn Error>> {
         })
         .ok_or("no particles")?;
     println!(
-        "colliding disks: {} particles, {} triangles, Δt = {DT}, T = {END}",
+        "colliding disks: {} particles, {} triangles, Δt = {}, T = {}",
         particles.len(),
-        mesh.simplex_count()
+        mesh.simplex_count(),
+        scene.dt,
+        scene.end_time
     );
-    let umls = run(Umls2::new(mesh.clone()), tracer)?;
-    let fe = run(LinearFeKernel::new(mesh), tracer)?;
+    let umls = run(&scene, Umls2::new(mesh.clone()), tracer)?;
+    let fe = run(&scene, LinearFeKernel::new(mesh), tracer)?;
     let k0 = umls.history[0].kinetic;
     println!("\n  time   UMLS kinetic  strain   total  | linear FE kinetic  strain   total");
     for (a, b) in umls.history.iter().zip(&fe.history).step_by(25) {
@@ -196,7 +156,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         "stress roughness of the traced particle: UMLS {ru:.2e}, linear FE {rf:.2e} ({:.0}× rougher)",
         rf / ru
     );
-    let steps = (END / DT).round();
+    let steps = (scene.end_time / scene.dt).round();
     println!(
         "wall time: UMLS {:.2} s ({:.2e} particle-steps/s), linear FE {:.2} s",
         umls.wall,
@@ -236,7 +196,7 @@ fn plot_energies(
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d(0.0..END, 0.0..top)?;
+        .build_cartesian_2d(0.0..3.0, 0.0..top)?;
     chart
         .configure_mesh()
         .x_desc("time")
@@ -290,7 +250,7 @@ fn plot_stress(path: &Path, umls: &[(f64, f64)], fe: &[(f64, f64)]) -> Result<()
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(70)
-        .build_cartesian_2d(0.0..END, (lo - pad)..(hi + pad))?;
+        .build_cartesian_2d(0.0..3.0, (lo - pad)..(hi + pad))?;
     chart
         .configure_mesh()
         .x_desc("time")

@@ -13,7 +13,8 @@
 //!   manifold in Rⁿ;
 //! - [`transfer`] (`umls-transfer`), [`kernels`] (`umls-kernels`), [`engine`]
 //!   (`umls-engine`): the kernel port, the UMLS / linear-FE / B-spline kernels, and the
-//!   explicit MPM engine.
+//!   explicit MPM engine;
+//! - [`scenes`] (`umls-scenes`): the benchmark scenes with their references.
 //!
 //! ```
 //! use umls::mesh::generate::{Diagonal, Lattice};
@@ -33,4 +34,5 @@ pub use umls_kernels as kernels;
 pub use umls_manifold as manifold;
 pub use umls_mesh as mesh;
 pub use umls_mls as mls;
+pub use umls_scenes as scenes;
 pub use umls_transfer as transfer;

@@ -1,0 +1,149 @@
+//! The 1D vibrating bar: L = 25, E = 100, ρ = 1, fixed at x = 0, free at x = L,
+//! v(x, 0) = v₀ sin(βx), β = π/(2L), ω = β √(E/ρ). Analytic (linear elasticity, small
+//! displacement): v(X, t) = v₀ cos(ωt) sin(βX), u(X, t) = (v₀/ω) sin(ωt) sin(βX).
+
+use std::f64::consts::PI;
+
+use nalgebra::SVector;
+use umls_constitutive::{ConstitutiveError, ElasticParameters, LinearElastic};
+use umls_engine::{EngineError, Particles, Simulation, StepSettings, TransferScheme};
+use umls_mesh::generate::Lattice;
+use umls_mesh::{MeshError, SimplexMesh};
+use umls_transfer::Kernel;
+
+/// Parameters of the scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VibratingBar {
+    /// Bar length L.
+    pub length: f64,
+    /// Young's modulus E.
+    pub young: f64,
+    /// Density ρ.
+    pub density: f64,
+    /// Velocity amplitude v₀.
+    pub amplitude: f64,
+    /// Cells along the bar.
+    pub cells: usize,
+    /// Particles per cell.
+    pub particles_per_cell: usize,
+    /// Δt as a fraction of Δx / c (0.1 in the textbook run).
+    pub courant: f64,
+    /// End time as a multiple of the period.
+    pub periods: f64,
+}
+
+impl Default for VibratingBar {
+    /// The textbook run: 13 cells, 1 particle per cell, Δt = 0.1 Δx / c, one period.
+    fn default() -> Self {
+        Self {
+            length: 25.0,
+            young: 100.0,
+            density: 1.0,
+            amplitude: 0.1,
+            cells: 13,
+            particles_per_cell: 1,
+            courant: 0.1,
+            periods: 1.0,
+        }
+    }
+}
+
+/// Velocity error and energy drift of a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BarError {
+    /// RMS over particles and steps of v − v_exact, relative to v₀.
+    pub velocity_rmse: f64,
+    /// Largest |E(t) − E(0)| / E(0).
+    pub energy_error: f64,
+}
+
+impl VibratingBar {
+    /// Wave number β = π / (2L).
+    pub fn beta(&self) -> f64 {
+        PI / (2.0 * self.length)
+    }
+
+    /// Angular frequency ω = β √(E/ρ).
+    pub fn omega(&self) -> f64 {
+        self.beta() * (self.young / self.density).sqrt()
+    }
+
+    /// Cell size Δx = L / cells.
+    pub fn dx(&self) -> f64 {
+        self.length / self.cells as f64
+    }
+
+    /// Analytic velocity at reference position `x` and time `t`.
+    pub fn velocity(&self, x: f64, t: f64) -> f64 {
+        self.amplitude * (self.omega() * t).cos() * (self.beta() * x).sin()
+    }
+
+    /// The mesh: cells of Δx on [0, L + 4Δx], room for the free end to move.
+    pub fn mesh(&self) -> Result<SimplexMesh<1>, MeshError> {
+        Lattice::new([0.0], [self.length + 4.0 * self.dx()], [self.cells + 4]).segments()
+    }
+
+    /// Particles at the midpoints of equal sub-cells, v(x, 0) = v₀ sin(βx).
+    pub fn particles<C: Copy + Default>(&self) -> Particles<1, (), C> {
+        let n = self.cells * self.particles_per_cell;
+        let h = self.dx() / self.particles_per_cell as f64;
+        let x: Vec<SVector<f64, 1>> = (0..n)
+            .map(|k| SVector::from([(k as f64 + 0.5) * h]))
+            .collect();
+        let mut p = Particles::at_rest(x, vec![h; n], self.density, ());
+        for (v, x) in p.velocity.iter_mut().zip(&p.position) {
+            *v = SVector::from([self.velocity(x[0], 0.0)]);
+        }
+        p
+    }
+
+    /// The material (1D: uniaxial stress with modulus E).
+    pub fn material(&self) -> Result<LinearElastic, ConstitutiveError> {
+        Ok(LinearElastic {
+            parameters: ElasticParameters::from_young_poisson(self.young, 0.0)?,
+        })
+    }
+
+    /// Time step: `courant` · Δx / c, rounded so that the run ends exactly at `periods` periods.
+    pub fn steps_and_dt(&self) -> (usize, f64) {
+        let end = self.periods * 2.0 * PI / self.omega();
+        let target = self.courant * self.dx() / (self.young / self.density).sqrt();
+        let steps = (end / target).ceil() as usize;
+        (steps, end / steps as f64)
+    }
+
+    /// Runs the scene with `kernel` (whose node 0 must be the vertex at x = 0, as on
+    /// [`Self::mesh`]) and `transfer`, and measures the error against the analytic solution.
+    pub fn run<K: Kernel<1>, T: TransferScheme>(
+        &self,
+        kernel: K,
+        transfer: T,
+    ) -> Result<BarError, EngineError> {
+        let material = self.material().map_err(|source| EngineError::Material {
+            step: 0,
+            particle: 0,
+            source,
+        })?;
+        let (steps, dt) = self.steps_and_dt();
+        let particles = self.particles();
+        let reference: Vec<f64> = particles.position.iter().map(|x| x[0]).collect();
+        let mut sim =
+            Simulation::new(kernel, material, transfer, particles, StepSettings::new(dt))?;
+        sim.boundary.fixed = vec![0];
+        let e0 = sim.diagnostics()?.total_energy();
+        let (mut sq, mut count, mut energy_error) = (0.0, 0.0, 0.0f64);
+        for _ in 0..steps {
+            sim.step()?;
+            energy_error = energy_error.max((sim.diagnostics()?.total_energy() - e0).abs() / e0);
+            let t = sim.time();
+            for (v, x) in sim.particles.velocity.iter().zip(&reference) {
+                sq += (v[0] - self.velocity(*x, t)).powi(2);
+                count += 1.0;
+            }
+        }
+        Ok(BarError {
+            velocity_rmse: (sq / count).sqrt() / self.amplitude,
+            energy_error,
+        })
+    }
+}
