@@ -206,7 +206,7 @@ fn kernel_error_paths() {
 #[test]
 fn support_radii_cover_every_stencil() {
     let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [6, 6])
-        .jitter(0.25, 8)
+        .jitter(0.2, 8)
         .triangles(Diagonal::Crossed)
         .unwrap();
     let kernel = UmlsKernel::new(&mesh);

@@ -168,7 +168,7 @@ fn survey<const D: usize>(mesh: &SimplexMesh<D>, eval: &Evaluator<'_, D>) -> Sum
 fn meshes_2d() -> Vec<SimplexMesh<2>> {
     [
         (Diagonal::Right, 0.2, 0.0),
-        (Diagonal::Alternating, 0.25, 0.6),
+        (Diagonal::Alternating, 0.2, 0.6),
         (Diagonal::Crossed, 0.15, 1.1),
     ]
     .into_iter()

@@ -3,17 +3,19 @@
 
 use proptest::prelude::*;
 use umls_mesh::SimplexMesh;
-use umls_mesh::generate::{Diagonal, Lattice, Spacing};
+use umls_mesh::generate::{Diagonal, Lattice, MAX_JITTER, Spacing};
 
 /// Random graded, jittered interval meshes.
 pub fn interval() -> impl Strategy<Value = SimplexMesh<1>> {
-    (1usize..30, 0.0f64..0.25, any::<u64>(), 0.2f64..5.0).prop_map(|(n, jitter, seed, ratio)| {
-        Lattice::new([-1.0], [2.0], [n])
-            .spacing([Spacing::Graded { ratio }])
-            .jitter(jitter, seed)
-            .segments()
-            .expect("valid interval")
-    })
+    (1usize..30, 0.0f64..=MAX_JITTER, any::<u64>(), 0.2f64..5.0).prop_map(
+        |(n, jitter, seed, ratio)| {
+            Lattice::new([-1.0], [2.0], [n])
+                .spacing([Spacing::Graded { ratio }])
+                .jitter(jitter, seed)
+                .segments()
+                .expect("valid interval")
+        },
+    )
 }
 
 /// Any triangle split pattern.
@@ -31,7 +33,7 @@ pub fn rectangle() -> impl Strategy<Value = SimplexMesh<2>> {
     (
         1usize..9,
         1usize..9,
-        0.0f64..0.25,
+        0.0f64..=MAX_JITTER,
         any::<u64>(),
         0.0f64..6.3,
         diagonal(),
@@ -51,7 +53,7 @@ pub fn cuboid() -> impl Strategy<Value = SimplexMesh<3>> {
         1usize..5,
         1usize..5,
         1usize..5,
-        0.0f64..0.25,
+        0.0f64..=MAX_JITTER,
         any::<u64>(),
         0.0f64..6.3,
     )

@@ -4,11 +4,11 @@
 use nalgebra::SVector;
 use proptest::prelude::*;
 use umls_mesh::SimplexMesh;
-use umls_mesh::generate::{Diagonal, Lattice};
+use umls_mesh::generate::{Diagonal, Lattice, MAX_JITTER};
 
 /// Random graded, jittered interval meshes.
 pub fn interval() -> impl Strategy<Value = SimplexMesh<1>> {
-    (4usize..20, 0.0f64..0.25, any::<u64>()).prop_map(|(n, jitter, seed)| {
+    (4usize..20, 0.0f64..=MAX_JITTER, any::<u64>()).prop_map(|(n, jitter, seed)| {
         Lattice::new([-1.0], [1.0], [n])
             .jitter(jitter, seed)
             .segments()
@@ -26,7 +26,7 @@ pub fn rectangle() -> impl Strategy<Value = SimplexMesh<2>> {
     (
         3usize..8,
         3usize..8,
-        0.0f64..0.25,
+        0.0f64..=MAX_JITTER,
         any::<u64>(),
         0.0f64..6.3,
         diagonal,
@@ -46,7 +46,7 @@ pub fn cuboid() -> impl Strategy<Value = SimplexMesh<3>> {
         2usize..4,
         2usize..4,
         2usize..4,
-        0.0f64..0.25,
+        0.0f64..=MAX_JITTER,
         any::<u64>(),
         0.0f64..6.3,
     )
@@ -94,11 +94,13 @@ pub fn interior_simplices<const D: usize>(mesh: &SimplexMesh<D>) -> Vec<usize> {
 
 /// A larger box for the quadratic basis: enough cells for simplices with complete 1-rings.
 pub fn fine_cuboid() -> impl Strategy<Value = SimplexMesh<3>> {
-    (4usize..6, 0.0f64..0.25, any::<u64>(), 0.0f64..6.3).prop_map(|(n, jitter, seed, angle)| {
-        Lattice::new([0.0; 3], [1.0; 3], [n, n, n])
-            .jitter(jitter, seed)
-            .rotate_about([0.3, -1.0, 0.5], angle)
-            .tetrahedra()
-            .unwrap()
-    })
+    (4usize..6, 0.0f64..=MAX_JITTER, any::<u64>(), 0.0f64..6.3).prop_map(
+        |(n, jitter, seed, angle)| {
+            Lattice::new([0.0; 3], [1.0; 3], [n, n, n])
+                .jitter(jitter, seed)
+                .rotate_about([0.3, -1.0, 0.5], angle)
+                .tetrahedra()
+                .unwrap()
+        },
+    )
 }
