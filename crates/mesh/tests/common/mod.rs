@@ -7,13 +7,14 @@ use umls_mesh::generate::{Diagonal, Lattice, MAX_JITTER, Spacing};
 
 /// Random graded, jittered interval meshes.
 pub fn interval() -> impl Strategy<Value = SimplexMesh<1>> {
-    (1usize..30, 0.0f64..=MAX_JITTER, any::<u64>(), 0.2f64..5.0).prop_map(
+    (1usize..30, 0.0f64..=MAX_JITTER, any::<u64>(), 0.2f64..5.0).prop_filter_map(
+        "generated mesh is valid",
         |(n, jitter, seed, ratio)| {
             Lattice::new([-1.0], [2.0], [n])
                 .spacing([Spacing::Graded { ratio }])
                 .jitter(jitter, seed)
                 .segments()
-                .expect("valid interval")
+                .ok()
         },
     )
 }
@@ -38,13 +39,16 @@ pub fn rectangle() -> impl Strategy<Value = SimplexMesh<2>> {
         0.0f64..6.3,
         diagonal(),
     )
-        .prop_map(|(nx, ny, jitter, seed, angle, diagonal)| {
-            Lattice::new([0.0, 0.0], [2.0, 1.0], [nx, ny])
-                .jitter(jitter, seed)
-                .rotate_by(angle)
-                .triangles(diagonal)
-                .expect("valid rectangle")
-        })
+        .prop_filter_map(
+            "generated mesh is valid",
+            |(nx, ny, jitter, seed, angle, diagonal)| {
+                Lattice::new([0.0, 0.0], [2.0, 1.0], [nx, ny])
+                    .jitter(jitter, seed)
+                    .rotate_by(angle)
+                    .triangles(diagonal)
+                    .ok()
+            },
+        )
 }
 
 /// Random jittered, rotated box tetrahedralisations.
@@ -57,11 +61,14 @@ pub fn cuboid() -> impl Strategy<Value = SimplexMesh<3>> {
         any::<u64>(),
         0.0f64..6.3,
     )
-        .prop_map(|(nx, ny, nz, jitter, seed, angle)| {
-            Lattice::new([0.0, 0.0, 0.0], [1.0, 1.5, 0.5], [nx, ny, nz])
-                .jitter(jitter, seed)
-                .rotate_about([1.0, 2.0, 3.0], angle)
-                .tetrahedra()
-                .expect("valid box")
-        })
+        .prop_filter_map(
+            "generated mesh is valid",
+            |(nx, ny, nz, jitter, seed, angle)| {
+                Lattice::new([0.0, 0.0, 0.0], [1.0, 1.5, 0.5], [nx, ny, nz])
+                    .jitter(jitter, seed)
+                    .rotate_about([1.0, 2.0, 3.0], angle)
+                    .tetrahedra()
+                    .ok()
+            },
+        )
 }

@@ -8,12 +8,15 @@ use umls_mesh::generate::{Diagonal, Lattice, MAX_JITTER};
 
 /// Random graded, jittered interval meshes.
 pub fn interval() -> impl Strategy<Value = SimplexMesh<1>> {
-    (4usize..20, 0.0f64..=MAX_JITTER, any::<u64>()).prop_map(|(n, jitter, seed)| {
-        Lattice::new([-1.0], [1.0], [n])
-            .jitter(jitter, seed)
-            .segments()
-            .unwrap()
-    })
+    (4usize..20, 0.0f64..=MAX_JITTER, any::<u64>()).prop_filter_map(
+        "generated mesh is valid",
+        |(n, jitter, seed)| {
+            Lattice::new([-1.0], [1.0], [n])
+                .jitter(jitter, seed)
+                .segments()
+                .ok()
+        },
+    )
 }
 
 /// Random jittered, rotated rectangle meshes with any split pattern.
@@ -31,13 +34,16 @@ pub fn rectangle() -> impl Strategy<Value = SimplexMesh<2>> {
         0.0f64..6.3,
         diagonal,
     )
-        .prop_map(|(nx, ny, jitter, seed, angle, diagonal)| {
-            Lattice::new([0.0, 0.0], [1.0, 1.0], [nx, ny])
-                .jitter(jitter, seed)
-                .rotate_by(angle)
-                .triangles(diagonal)
-                .unwrap()
-        })
+        .prop_filter_map(
+            "generated mesh is valid",
+            |(nx, ny, jitter, seed, angle, diagonal)| {
+                Lattice::new([0.0, 0.0], [1.0, 1.0], [nx, ny])
+                    .jitter(jitter, seed)
+                    .rotate_by(angle)
+                    .triangles(diagonal)
+                    .ok()
+            },
+        )
 }
 
 /// Random jittered, rotated box tetrahedralisations.
@@ -50,13 +56,16 @@ pub fn cuboid() -> impl Strategy<Value = SimplexMesh<3>> {
         any::<u64>(),
         0.0f64..6.3,
     )
-        .prop_map(|(nx, ny, nz, jitter, seed, angle)| {
-            Lattice::new([0.0; 3], [1.0; 3], [nx, ny, nz])
-                .jitter(jitter, seed)
-                .rotate_about([0.3, -1.0, 0.5], angle)
-                .tetrahedra()
-                .unwrap()
-        })
+        .prop_filter_map(
+            "generated mesh is valid",
+            |(nx, ny, nz, jitter, seed, angle)| {
+                Lattice::new([0.0; 3], [1.0; 3], [nx, ny, nz])
+                    .jitter(jitter, seed)
+                    .rotate_about([0.3, -1.0, 0.5], angle)
+                    .tetrahedra()
+                    .ok()
+            },
+        )
 }
 
 /// A point inside simplex `s` from D+1 positive weights (normalised to barycentric coordinates).
@@ -94,13 +103,14 @@ pub fn interior_simplices<const D: usize>(mesh: &SimplexMesh<D>) -> Vec<usize> {
 
 /// A larger box for the quadratic basis: enough cells for simplices with complete 1-rings.
 pub fn fine_cuboid() -> impl Strategy<Value = SimplexMesh<3>> {
-    (4usize..6, 0.0f64..=MAX_JITTER, any::<u64>(), 0.0f64..6.3).prop_map(
+    (4usize..6, 0.0f64..=MAX_JITTER, any::<u64>(), 0.0f64..6.3).prop_filter_map(
+        "generated mesh is valid",
         |(n, jitter, seed, angle)| {
             Lattice::new([0.0; 3], [1.0; 3], [n, n, n])
                 .jitter(jitter, seed)
                 .rotate_about([0.3, -1.0, 0.5], angle)
                 .tetrahedra()
-                .unwrap()
+                .ok()
         },
     )
 }
