@@ -42,11 +42,13 @@
 
 mod error;
 mod particles;
+mod seeding;
 mod simulation;
 mod stencils;
 mod transfer;
 
 pub use error::EngineError;
 pub use particles::Particles;
+pub use seeding::{Inside, Region, lattice_samples};
 pub use simulation::{Boundary, Diagnostics, Simulation, StepSettings};
 pub use transfer::{Apic, Flip, Pic, StressUpdate, TransferScheme, VelocityGradientAffine};

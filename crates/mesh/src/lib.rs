@@ -17,7 +17,8 @@
 //!
 //! [`generate::Lattice`] builds interval, rectangle and box meshes, graded,
 //! jittered and rotated, for tests and benchmark scenes; [`SimplexMesh::quality_summary`]
-//! reports radius ratios, angles and edge ratios.
+//! reports radius ratios, angles and edge ratios; [`SimplexMesh::sample_points`] places
+//! quadrature-rule sample points (centroid, degree-2 Gauss) for seeding material points.
 //!
 //! ```
 //! use umls_mesh::{generate::{Diagonal, Lattice}, SimplexMesh};
@@ -48,6 +49,7 @@ mod geometry;
 mod locate;
 mod mesh;
 mod quality;
+mod sampling;
 mod topology;
 
 pub use barycentric::{Barycentric, BarycentricGradients, MAX_SIMPLEX_VERTICES};
@@ -56,4 +58,5 @@ pub use error::MeshError;
 pub use locate::{INSIDE_TOLERANCE, Located, Walk};
 pub use mesh::{DEGENERACY_TOLERANCE, EntityCounts, Orientation, Point, SimplexMesh};
 pub use quality::{QualitySummary, SimplexQuality};
+pub use sampling::SampleRule;
 pub use topology::{BoundaryFacet, OneRing, Topology};

@@ -169,3 +169,67 @@ fn crossed_pattern_adds_centres() {
     assert_eq!(mesh.simplex_count(), 24);
     assert_eq!(mesh.entity_counts().euler_characteristic(), 1);
 }
+
+/// Sample volumes sum to the mesh volume; the centroid rule integrates linear fields and
+/// the Gauss rule quadratic fields exactly, in 1D, 2D and 3D.
+#[test]
+fn sample_rules_integrate_exactly() {
+    use umls_mesh::SampleRule;
+    fn check<const D: usize>(mesh: &SimplexMesh<D>, exact_linear: f64, exact_quadratic: f64) {
+        let linear = |x: &nalgebra::SVector<f64, D>| {
+            1.0 + x
+                .iter()
+                .enumerate()
+                .map(|(k, c)| (k as f64 + 1.0) * c)
+                .sum::<f64>()
+        };
+        let quadratic =
+            |x: &nalgebra::SVector<f64, D>| x.iter().map(|c| c * c).sum::<f64>() + x[0] * x[D - 1];
+        for rule in [SampleRule::Centroid, SampleRule::Gauss2] {
+            let samples = mesh.sample_points(rule);
+            assert_eq!(samples.len(), mesh.simplex_count() * rule.count(D));
+            let volume: f64 = samples.iter().map(|(_, v)| v).sum();
+            assert!((volume - mesh.total_volume()).abs() < 1e-12);
+            let integral: f64 = samples.iter().map(|(x, v)| linear(x) * v).sum();
+            assert!(
+                (integral - exact_linear).abs() < 1e-12,
+                "{rule:?} linear: {integral} vs {exact_linear}"
+            );
+            if rule == SampleRule::Gauss2 {
+                let integral: f64 = samples.iter().map(|(x, v)| quadratic(x) * v).sum();
+                assert!(
+                    (integral - exact_quadratic).abs() < 1e-12,
+                    "quadratic: {integral} vs {exact_quadratic}"
+                );
+            }
+            for (x, _) in &samples {
+                assert!(mesh.locate(x).is_some());
+            }
+        }
+    }
+    // On [0, 1]^D: ∫ 1 + Σ (k+1) x_k = 1 + Σ (k+1)/2; ∫ Σ x_k² + x_0 x_{D−1} = D/3 + (1/3 if D = 1 else 1/4).
+    check(
+        &Lattice::new([0.0], [1.0], [7])
+            .jitter(0.2, 1)
+            .segments()
+            .unwrap(),
+        1.5,
+        1.0 / 3.0 + 1.0 / 3.0,
+    );
+    check(
+        &Lattice::new([0.0; 2], [1.0; 2], [5, 4])
+            .jitter(0.2, 2)
+            .triangles(Diagonal::Crossed)
+            .unwrap(),
+        1.0 + 0.5 + 1.0,
+        2.0 / 3.0 + 0.25,
+    );
+    check(
+        &Lattice::new([0.0; 3], [1.0; 3], [3, 3, 3])
+            .jitter(0.2, 3)
+            .tetrahedra()
+            .unwrap(),
+        1.0 + 0.5 + 1.0 + 1.5,
+        1.0 + 0.25,
+    );
+}

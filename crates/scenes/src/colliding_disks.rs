@@ -6,7 +6,9 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix2, Vector2};
 use umls_constitutive::{ConstitutiveError, ElasticParameters, LinearElastic};
-use umls_engine::{EngineError, Particles, Simulation, StepSettings, TransferScheme};
+use umls_engine::{
+    EngineError, Particles, Region, Simulation, StepSettings, TransferScheme, lattice_samples,
+};
 use umls_mesh::generate::{Diagonal, Lattice};
 use umls_mesh::{MeshError, SimplexMesh};
 use umls_transfer::Kernel;
@@ -62,30 +64,21 @@ impl CollidingDisks {
     /// The two disks' particles on a regular lattice, moving towards each other.
     pub fn particles<C: Copy + Default>(&self) -> Particles<2, (), C> {
         let spacing = 1.0 / (self.cells * self.particles_per_side) as f64;
-        let per_disk = (0.4 / spacing).round() as usize;
-        let mut x = Vec::new();
-        let mut v = Vec::new();
+        let mut particles = Particles::at_rest(Vec::new(), Vec::new(), self.density, ());
         for (centre, sign) in [
             (Vector2::new(0.2, 0.2), 1.0),
             (Vector2::new(0.8, 0.8), -1.0),
         ] {
-            for i in 0..per_disk {
-                for j in 0..per_disk {
-                    let p = centre
-                        + Vector2::new(
-                            -0.2 + (i as f64 + 0.5) * spacing,
-                            -0.2 + (j as f64 + 0.5) * spacing,
-                        );
-                    if (p - centre).norm() < 0.2 {
-                        x.push(p);
-                        v.push(Vector2::new(self.speed, self.speed) * sign);
-                    }
-                }
-            }
+            let lattice = lattice_samples(centre.add_scalar(-0.2), centre.add_scalar(0.2), spacing);
+            let disk = Region::Ball {
+                centre,
+                radius: 0.2,
+            };
+            let velocity = Vector2::new(self.speed, self.speed) * sign;
+            particles.append(Particles::seed(&lattice, &disk, self.density, (), |_| {
+                velocity
+            }));
         }
-        let n = x.len();
-        let mut particles = Particles::at_rest(x, vec![spacing * spacing; n], self.density, ());
-        particles.velocity = v;
         particles
     }
 

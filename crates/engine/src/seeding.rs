@@ -1,0 +1,130 @@
+//! Seeding material points: regions of space, and particles from sample points.
+
+use std::sync::Arc;
+
+use nalgebra::SVector;
+
+use crate::particles::Particles;
+
+/// A point-in-region predicate.
+pub type Inside<const D: usize> = Arc<dyn Fn(&SVector<f64, D>) -> bool + Send + Sync>;
+
+/// A region of space that material occupies.
+#[derive(Clone)]
+pub enum Region<const D: usize> {
+    /// All of space.
+    Everywhere,
+    /// The axis-aligned box lower ≤ x ≤ upper.
+    Box {
+        /// Lower corner.
+        lower: SVector<f64, D>,
+        /// Upper corner.
+        upper: SVector<f64, D>,
+    },
+    /// The ball ‖x − centre‖ ≤ radius (a disk in 2D, an interval in 1D).
+    Ball {
+        /// Centre.
+        centre: SVector<f64, D>,
+        /// Radius.
+        radius: f64,
+    },
+    /// The half-space n·x ≤ offset.
+    HalfSpace {
+        /// Outward normal n (any length).
+        normal: SVector<f64, D>,
+        /// Offset.
+        offset: f64,
+    },
+    /// Any point-in-region predicate.
+    Predicate(Inside<D>),
+    /// Points in all of the regions.
+    Intersection(Vec<Region<D>>),
+}
+
+impl<const D: usize> std::fmt::Debug for Region<D> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Region::Everywhere => write!(f, "Everywhere"),
+            Region::Box { lower, upper } => {
+                write!(f, "Box({:?}, {:?})", lower.as_slice(), upper.as_slice())
+            }
+            Region::Ball { centre, radius } => write!(f, "Ball({:?}, {radius})", centre.as_slice()),
+            Region::HalfSpace { normal, offset } => {
+                write!(f, "HalfSpace({:?}, {offset})", normal.as_slice())
+            }
+            Region::Predicate(_) => write!(f, "Predicate"),
+            Region::Intersection(parts) => f.debug_list().entries(parts).finish(),
+        }
+    }
+}
+
+impl<const D: usize> Region<D> {
+    /// Whether `x` lies in the region.
+    pub fn contains(&self, x: &SVector<f64, D>) -> bool {
+        match self {
+            Region::Everywhere => true,
+            Region::Box { lower, upper } => (0..D).all(|k| lower[k] <= x[k] && x[k] <= upper[k]),
+            Region::Ball { centre, radius } => (x - centre).norm() <= *radius,
+            Region::HalfSpace { normal, offset } => normal.dot(x) <= *offset,
+            Region::Predicate(inside) => inside(x),
+            Region::Intersection(parts) => parts.iter().all(|r| r.contains(x)),
+        }
+    }
+}
+
+/// Sample points (centres) of a regular lattice with spacing `h` filling the box
+/// [lower, upper], each with volume h^D: seeding for grid kernels.
+pub fn lattice_samples<const D: usize>(
+    lower: SVector<f64, D>,
+    upper: SVector<f64, D>,
+    h: f64,
+) -> Vec<(SVector<f64, D>, f64)> {
+    let counts: [usize; D] =
+        std::array::from_fn(|k| ((upper[k] - lower[k]) / h).round().max(0.0) as usize);
+    let total: usize = counts.iter().product();
+    (0..total)
+        .map(|mut index| {
+            let x = SVector::<f64, D>::from_fn(|k, _| {
+                let i = index % counts[k];
+                index /= counts[k];
+                lower[k] + (i as f64 + 0.5) * h
+            });
+            (x, h.powi(D as i32))
+        })
+        .collect()
+}
+
+impl<const D: usize, S: Clone, C: Copy + Default> Particles<D, S, C> {
+    /// Particles at the `samples` (point, volume) that lie in `region`, with density
+    /// `density`, the material state `state` and initial velocity `velocity(x)`.
+    pub fn seed(
+        samples: &[(SVector<f64, D>, f64)],
+        region: &Region<D>,
+        density: f64,
+        state: S,
+        velocity: impl Fn(&SVector<f64, D>) -> SVector<f64, D>,
+    ) -> Self {
+        let (positions, volumes): (Vec<_>, Vec<_>) = samples
+            .iter()
+            .filter(|(x, _)| region.contains(x))
+            .copied()
+            .unzip();
+        let mut particles = Self::at_rest(positions, volumes, density, state);
+        for (v, x) in particles.velocity.iter_mut().zip(&particles.position) {
+            *v = velocity(x);
+        }
+        particles
+    }
+
+    /// Appends `other` (for scenes with several bodies or materials' worth of points).
+    pub fn append(&mut self, other: Self) {
+        self.position.extend(other.position);
+        self.velocity.extend(other.velocity);
+        self.affine.extend(other.affine);
+        self.deformation.extend(other.deformation);
+        self.volume.extend(other.volume);
+        self.mass.extend(other.mass);
+        self.state.extend(other.state);
+        self.cache.extend(other.cache);
+    }
+}
