@@ -50,5 +50,5 @@ mod transfer;
 pub use error::EngineError;
 pub use particles::Particles;
 pub use seeding::{Inside, Region, lattice_samples};
-pub use simulation::{Boundary, Diagnostics, Simulation, StepSettings};
+pub use simulation::{BodyForce, Boundary, Diagnostics, Simulation, StepSettings};
 pub use transfer::{Apic, Flip, Pic, StressUpdate, TransferScheme, VelocityGradientAffine};

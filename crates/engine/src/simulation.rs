@@ -11,6 +11,10 @@ use crate::particles::Particles;
 use crate::stencils::Stencils;
 use crate::transfer::{StressUpdate, TransferScheme};
 
+/// A body acceleration field b(x, t), added to gravity.
+pub type BodyForce<const D: usize> =
+    std::sync::Arc<dyn Fn(&SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync>;
+
 /// Velocity boundary conditions on grid nodes.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Boundary<const D: usize> {
@@ -25,6 +29,48 @@ pub struct Boundary<const D: usize> {
 }
 
 impl<const D: usize> Boundary<D> {
+    /// Nodes of `kernel` within `tolerance` of the plane through `point` with normal `normal`.
+    pub fn nodes_on_plane<K: Kernel<D>>(
+        kernel: &K,
+        point: &SVector<f64, D>,
+        normal: &SVector<f64, D>,
+        tolerance: f64,
+    ) -> Vec<u32> {
+        let unit = normal.normalize();
+        (0..kernel.node_count())
+            .filter(|&n| (kernel.node_position(n) - point).dot(&unit).abs() <= tolerance)
+            .map(|n| n as u32)
+            .collect()
+    }
+
+    /// Fixes every node on the plane (see [`Self::nodes_on_plane`]).
+    pub fn fix_plane<K: Kernel<D>>(
+        &mut self,
+        kernel: &K,
+        point: &SVector<f64, D>,
+        normal: &SVector<f64, D>,
+        tolerance: f64,
+    ) {
+        self.fixed
+            .extend(Self::nodes_on_plane(kernel, point, normal, tolerance));
+    }
+
+    /// Frictionless slip along the plane for every node on it, with the plane's unit normal.
+    pub fn slip_plane<K: Kernel<D>>(
+        &mut self,
+        kernel: &K,
+        point: &SVector<f64, D>,
+        normal: &SVector<f64, D>,
+        tolerance: f64,
+    ) {
+        let unit = normal.normalize();
+        self.slip.extend(
+            Self::nodes_on_plane(kernel, point, normal, tolerance)
+                .into_iter()
+                .map(|n| (n, unit)),
+        );
+    }
+
     fn apply(&self, velocity: &mut [SVector<f64, D>]) {
         for &node in &self.fixed {
             velocity[node as usize] = SVector::zeros();
@@ -120,6 +166,8 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     pub boundary: Boundary<D>,
     /// Step settings.
     pub settings: StepSettings<D>,
+    /// Optional body acceleration field b(x, t), added to `settings.gravity`.
+    pub body_force: Option<BodyForce<D>>,
     step: usize,
     time: f64,
     initial_energy: Option<f64>,
@@ -155,6 +203,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             particles,
             boundary: Boundary::default(),
             settings,
+            body_force: None,
             step: 0,
             time: 0.0,
             initial_energy: None,
@@ -284,6 +333,11 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         for (i, stress) in stresses.iter().enumerate() {
             let (m, v, c, x) = (p.mass[i], p.velocity[i], p.affine[i], p.position[i]);
             let stress_volume = stress * p.volume[i];
+            let acceleration = self.settings.gravity
+                + self
+                    .body_force
+                    .as_ref()
+                    .map_or(SVector::zeros(), |b| b(&x, self.time));
             for e in self.stencils.range(i) {
                 let node = self.stencils.nodes[e] as usize;
                 let n = self.stencils.values[e];
@@ -294,7 +348,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 }
                 self.node_momentum[node] += mv * (n * m);
                 self.node_force[node] +=
-                    self.settings.gravity * (n * m) - stress_volume * self.stencils.gradients[e];
+                    acceleration * (n * m) - stress_volume * self.stencils.gradients[e];
             }
         }
         // 3. Grid update.

@@ -7,8 +7,9 @@
 
 use std::sync::Arc;
 
+use nalgebra::SVector;
 use umls_engine::{Apic, EngineError, Flip, Simulation, StepSettings};
-use umls_kernels::{HostCache, LinearFeKernel, Umls1};
+use umls_kernels::{BSplineKernel, BSplineOrder, HostCache, LinearFeKernel, Umls1};
 use umls_scenes::vibrating_bar::{BarError, FixedEnd, VibratingBar};
 
 fn level(cells: usize) -> VibratingBar {
@@ -142,4 +143,29 @@ fn analytic_reference_and_time_step() {
     );
     assert!((bar.velocity(25.0, 0.0) - 0.1).abs() < 1e-15);
     assert!((bar.velocity(-25.0, 0.0) + 0.1).abs() < 1e-15);
+}
+
+/// Quadratic and cubic B-splines on a grid covering the mirrored bar, reported beside UMLS
+/// and linear FE: both converge.
+#[test]
+fn bspline_runs_beside() {
+    for order in [BSplineOrder::Quadratic, BSplineOrder::Cubic] {
+        let results: Vec<BarError> = [16usize, 32, 64]
+            .iter()
+            .map(|&cells| {
+                let bar = level(cells);
+                let dx = bar.dx();
+                let half = bar.length + 4.0 * dx;
+                let grid = BSplineKernel::new(SVector::from([-half]), dx, [2 * (cells + 4)], order)
+                    .unwrap();
+                bar.run(grid, Apic).unwrap()
+            })
+            .collect();
+        let orders = orders(&results);
+        eprintln!("{order:?} B-spline + APIC: {results:?}, orders {orders:?}");
+        assert!(
+            orders.iter().all(|&p| p >= 1.7),
+            "{order:?}: orders {orders:?}"
+        );
+    }
 }
