@@ -143,6 +143,33 @@ impl<const D: usize> Diagnostics<D> {
     }
 }
 
+/// Particle blocks of the parallel P2G scatter: a fixed number, so that results do not
+/// depend on the thread count; more blocks than cores keeps the work balanced.
+const P2G_BLOCKS: usize = 8;
+
+/// Below this many particles the scatter runs as one block: resetting and reducing the
+/// per-block grid buffers would cost more than it saves.
+const P2G_PARALLEL_MIN: usize = 8192;
+
+/// One block's share of the nodal sums.
+#[derive(Default)]
+struct GridBuffer<const D: usize> {
+    mass: Vec<f64>,
+    momentum: Vec<SVector<f64, D>>,
+    force: Vec<SVector<f64, D>>,
+}
+
+impl<const D: usize> GridBuffer<D> {
+    fn reset(&mut self, nodes: usize) {
+        self.mass.clear();
+        self.mass.resize(nodes, 0.0);
+        self.momentum.clear();
+        self.momentum.resize(nodes, SVector::zeros());
+        self.force.clear();
+        self.force.resize(nodes, SVector::zeros());
+    }
+}
+
 /// What G2P computes for one particle.
 struct ParticleUpdate<const D: usize> {
     velocity: SVector<f64, D>,
@@ -172,6 +199,7 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     time: f64,
     initial_energy: Option<f64>,
     stencils: Stencils<D>,
+    blocks: Vec<GridBuffer<D>>,
     node_mass: Vec<f64>,
     node_momentum: Vec<SVector<f64, D>>,
     node_force: Vec<SVector<f64, D>>,
@@ -208,6 +236,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             time: 0.0,
             initial_energy: None,
             stencils: Stencils::default(),
+            blocks: Vec::new(),
             node_mass: vec![0.0; nodes],
             node_momentum: vec![SVector::zeros(); nodes],
             node_force: vec![SVector::zeros(); nodes],
@@ -319,38 +348,63 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 particle,
                 source,
             })?;
-        // 2. P2G. Stresses in parallel; the scatter is serial, in particle order, so sums
-        // do not depend on the thread count.
+        // 2. P2G. Stresses in parallel, then the scatter in P2G_BLOCKS fixed particle blocks,
+        // each into its own grid buffer, in parallel; buffers are summed per node in block
+        // order. The split does not depend on the thread count, so neither do the sums.
         let stresses = self.stresses()?;
-        self.node_mass.iter_mut().for_each(|m| *m = 0.0);
-        self.node_momentum
-            .iter_mut()
-            .for_each(|m| *m = SVector::zeros());
-        self.node_force
-            .iter_mut()
-            .for_each(|f| *f = SVector::zeros());
         let p = &self.particles;
-        for (i, stress) in stresses.iter().enumerate() {
-            let (m, v, c, x) = (p.mass[i], p.velocity[i], p.affine[i], p.position[i]);
-            let stress_volume = stress * p.volume[i];
-            let acceleration = self.settings.gravity
-                + self
-                    .body_force
-                    .as_ref()
-                    .map_or(SVector::zeros(), |b| b(&x, self.time));
-            for e in self.stencils.range(i) {
-                let node = self.stencils.nodes[e] as usize;
-                let n = self.stencils.values[e];
-                self.node_mass[node] += n * m;
-                let mut mv = v;
-                if T::AFFINE {
-                    mv += c * (self.kernel.node_position(node) - x);
+        let (stencils, kernel, settings, time) =
+            (&self.stencils, &self.kernel, &self.settings, self.time);
+        let body_force = self.body_force.as_ref();
+        let block_count = if p.len() < P2G_PARALLEL_MIN {
+            1
+        } else {
+            P2G_BLOCKS
+        };
+        let block_len = p.len().div_ceil(block_count).max(1);
+        let nodes = self.node_mass.len();
+        self.blocks.resize_with(block_count, GridBuffer::default);
+        self.blocks
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(block, buffer)| {
+                buffer.reset(nodes);
+                let end = ((block + 1) * block_len).min(p.len());
+                let start = (block * block_len).min(end);
+                for (i, stress) in stresses.iter().enumerate().take(end).skip(start) {
+                    let (m, v, c, x) = (p.mass[i], p.velocity[i], p.affine[i], p.position[i]);
+                    let stress_volume = stress * p.volume[i];
+                    let acceleration =
+                        settings.gravity + body_force.map_or(SVector::zeros(), |b| b(&x, time));
+                    for e in stencils.range(i) {
+                        let node = stencils.nodes[e] as usize;
+                        let n = stencils.values[e];
+                        buffer.mass[node] += n * m;
+                        let mut mv = v;
+                        if T::AFFINE {
+                            mv += c * (kernel.node_position(node) - x);
+                        }
+                        buffer.momentum[node] += mv * (n * m);
+                        buffer.force[node] +=
+                            acceleration * (n * m) - stress_volume * stencils.gradients[e];
+                    }
                 }
-                self.node_momentum[node] += mv * (n * m);
-                self.node_force[node] +=
-                    acceleration * (n * m) - stress_volume * self.stencils.gradients[e];
-            }
-        }
+            });
+        let blocks = &self.blocks;
+        self.node_mass
+            .par_iter_mut()
+            .zip(self.node_momentum.par_iter_mut())
+            .zip(self.node_force.par_iter_mut())
+            .enumerate()
+            .for_each(|(node, ((mass, momentum), force))| {
+                *mass = blocks.iter().map(|b| b.mass[node]).sum();
+                *momentum = blocks
+                    .iter()
+                    .fold(SVector::zeros(), |acc, b| acc + b.momentum[node]);
+                *force = blocks
+                    .iter()
+                    .fold(SVector::zeros(), |acc, b| acc + b.force[node]);
+            });
         // 3. Grid update.
         let threshold =
             self.settings.min_mass_fraction * self.node_mass.iter().copied().fold(0.0, f64::max);

@@ -167,3 +167,104 @@ fn leaving_the_mesh_names_the_particle() {
         .is_err()
     );
 }
+
+/// Above the parallel-scatter threshold (8192 particles) the P2G scatter runs in eight
+/// blocks: results are still bitwise identical for 1 and 2 threads, and momentum is
+/// still conserved to round-off.
+#[test]
+fn blocked_scatter_is_deterministic_and_conservative() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let samples = umls_engine::lattice_samples(
+                SVector::from([0.1, 0.1]),
+                SVector::from([0.9, 0.9]),
+                0.0075,
+            );
+            let swirl = |x: &Vector2<f64>| {
+                Vector2::new(-(x.y - 0.5), x.x - 0.5) * 0.5 + Vector2::new(0.05, -0.02)
+            };
+            let particles = Particles::seed(
+                &samples,
+                &umls_engine::Region::Everywhere,
+                1000.0,
+                (),
+                swirl,
+            );
+            assert!(particles.len() > 8192);
+            let material = NeoHookean {
+                parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
+            };
+            let mut sim = Simulation::new(
+                Umls2::new(mesh()),
+                material,
+                Apic,
+                particles,
+                StepSettings::new(1e-4),
+            )
+            .unwrap();
+            let before = sim.diagnostics().unwrap().momentum;
+            for _ in 0..3 {
+                sim.step().unwrap();
+            }
+            let after = sim.diagnostics().unwrap().momentum;
+            assert!(
+                (after - before).norm() < 1e-12 * before.norm() * 1e3,
+                "{before:?} → {after:?}"
+            );
+            (
+                sim.particles.position.clone(),
+                sim.particles.velocity.clone(),
+            )
+        })
+    };
+    assert_eq!(run(1), run(2));
+}
+
+/// An ill-conditioned MLS system (sliver mesh of aspect 10⁷) stops the run with the
+/// kernel's typed error naming the simplex, wrapped with the step and particle.
+#[test]
+fn ill_conditioned_mls_stops_the_run() {
+    let mesh = Arc::new(
+        Lattice::new([0.0, 0.0], [1.0, 1e-7], [8, 2])
+            .triangles(Diagonal::Right)
+            .unwrap(),
+    );
+    let positions = (0..4)
+        .map(|k| Vector2::new(0.3 + 0.1 * k as f64, 5e-8))
+        .collect();
+    let particles = Particles::at_rest(positions, vec![1e-9; 4], 1000.0, ());
+    let material = NeoHookean {
+        parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
+    };
+    let mut sim = Simulation::new(
+        Umls2::new(mesh),
+        material,
+        Pic,
+        particles,
+        StepSettings::new(1e-4),
+    )
+    .unwrap();
+    let error = sim.step().unwrap_err();
+    match &error {
+        umls_engine::EngineError::Kernel {
+            step: 0,
+            source:
+                umls_transfer::KernelError::Mls(umls_mls::MlsError::IllConditioned {
+                    simplex: Some(_),
+                    ..
+                }),
+            ..
+        } => {}
+        other => panic!("unexpected {other}"),
+    }
+    assert!(
+        error
+            .to_string()
+            .contains("ill-conditioned moment matrix in simplex"),
+        "{error}"
+    );
+}
