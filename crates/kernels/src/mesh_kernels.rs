@@ -7,6 +7,23 @@ use umls_mesh::SimplexMesh;
 use umls_mls::{GradientKind, Linear, PolynomialBasis, UmlsKernel};
 use umls_transfer::{Kernel, KernelError, Stencil};
 
+/// The node methods of a kernel whose nodes are the vertices of `self.mesh`.
+macro_rules! mesh_nodes {
+    () => {
+        fn node_count(&self) -> usize {
+            self.mesh.vertex_count()
+        }
+
+        fn node_position(&self, node: usize) -> SVector<f64, D> {
+            *self.mesh.vertex(node)
+        }
+
+        fn spacing(&self) -> f64 {
+            self.mesh.min_edge_length()
+        }
+    };
+}
+
 /// The host simplex a particle was last found in (`None` before the first location).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct HostCache(pub Option<u32>);
@@ -69,17 +86,7 @@ where
 {
     type Cache = HostCache;
 
-    fn node_count(&self) -> usize {
-        self.mesh.vertex_count()
-    }
-
-    fn node_position(&self, node: usize) -> SVector<f64, D> {
-        *self.mesh.vertex(node)
-    }
-
-    fn spacing(&self) -> f64 {
-        self.mesh.min_edge_length()
-    }
+    mesh_nodes!();
 
     fn stencil(
         &self,
@@ -116,17 +123,7 @@ impl<const D: usize> LinearFeKernel<D> {
 impl<const D: usize> Kernel<D> for LinearFeKernel<D> {
     type Cache = HostCache;
 
-    fn node_count(&self) -> usize {
-        self.mesh.vertex_count()
-    }
-
-    fn node_position(&self, node: usize) -> SVector<f64, D> {
-        *self.mesh.vertex(node)
-    }
-
-    fn spacing(&self) -> f64 {
-        self.mesh.min_edge_length()
-    }
+    mesh_nodes!();
 
     fn stencil(
         &self,

@@ -284,16 +284,8 @@ impl ManifoldMls {
         &self,
         queries: &[f64],
     ) -> Result<Vec<Result<Estimate, ManifoldError>>, ManifoldError> {
-        let n = self.cloud.ambient_dim();
-        if queries.len() % n != 0 {
-            return Err(ManifoldError::LengthMismatch {
-                what: "queries (Q × n)",
-                expected: queries.len() / n * n,
-                found: queries.len(),
-            });
-        }
-        Ok(queries
-            .par_chunks_exact(n)
+        Ok(self
+            .query_rows(queries)?
             .map(|r| self.evaluate(r))
             .collect())
     }
@@ -303,6 +295,14 @@ impl ManifoldMls {
         &self,
         queries: &[f64],
     ) -> Result<Vec<Result<Vec<f64>, ManifoldError>>, ManifoldError> {
+        Ok(self.query_rows(queries)?.map(|r| self.project(r)).collect())
+    }
+
+    /// The rows of a flat Q × n query array, as a parallel iterator.
+    fn query_rows<'q>(
+        &self,
+        queries: &'q [f64],
+    ) -> Result<rayon::slice::ChunksExact<'q, f64>, ManifoldError> {
         let n = self.cloud.ambient_dim();
         if queries.len() % n != 0 {
             return Err(ManifoldError::LengthMismatch {
@@ -311,9 +311,6 @@ impl ManifoldMls {
                 found: queries.len(),
             });
         }
-        Ok(queries
-            .par_chunks_exact(n)
-            .map(|r| self.project(r))
-            .collect())
+        Ok(queries.par_chunks_exact(n))
     }
 }
