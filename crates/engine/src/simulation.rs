@@ -454,9 +454,11 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     pic += new_v[node] * n;
                     flip += (new_v[node] - old_v[node]) * n;
                     grad_v += new_v[node] * stencils.gradients[e].transpose();
-                    let r = kernel.node_position(node) - x;
-                    b += new_v[node] * r.transpose() * n;
-                    d += r * r.transpose() * n;
+                    if T::USES_MOMENTS {
+                        let r = kernel.node_position(node) - x;
+                        b += new_v[node] * r.transpose() * n;
+                        d += r * r.transpose() * n;
+                    }
                 }
                 ParticleUpdate {
                     velocity: transfer.velocity(&velocities[i], &pic, &flip),

@@ -9,6 +9,9 @@ pub trait TransferScheme: Copy + Send + Sync + std::fmt::Debug {
     /// Whether the affine matrix C_p enters P2G: (mv)_i += N m_p (v_p + C_p (x_i − x_p)).
     const AFFINE: bool;
 
+    /// Whether [`Self::affine`] reads B_p and D_p; G2P skips accumulating them otherwise.
+    const USES_MOMENTS: bool = false;
+
     /// Short name for reports.
     fn name(&self) -> &'static str;
 
@@ -87,6 +90,7 @@ impl TransferScheme for Flip {
 
 impl TransferScheme for Apic {
     const AFFINE: bool = true;
+    const USES_MOMENTS: bool = true;
     fn name(&self) -> &'static str {
         "APIC"
     }
