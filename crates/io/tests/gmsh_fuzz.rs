@@ -125,7 +125,7 @@ proptest! {
 
 #[test]
 fn every_truncation_of_every_fixture_is_an_error() {
-    for index in 0..FIXTURES.len() {
+    for (index, name) in FIXTURES.iter().enumerate() {
         let bytes = fixture(index);
         // Cutting anywhere before the final "$EndElements" loses data.
         let end = bytes
@@ -135,8 +135,7 @@ fn every_truncation_of_every_fixture_is_an_error() {
         for cut in 0..end {
             assert!(
                 parse_msh_any(&bytes[..cut], ReadOptions::default()).is_err(),
-                "{} cut at {cut} was accepted",
-                FIXTURES[index]
+                "{name} cut at {cut} was accepted"
             );
         }
     }

@@ -59,14 +59,17 @@ fn read_back(path: &PathBuf) -> Read {
     )
 }
 
-fn particles() -> (
+/// A particle cloud and the velocity, stress and id fields written into it.
+type Cloud = (
     UnstructuredGrid,
     Vec<Vector2<f64>>,
     Vec<Matrix2<f64>>,
     Vec<i32>,
-) {
+);
+
+fn particles() -> Cloud {
     // Values that need all 17 digits: thirds, tiny and huge magnitudes, negative zero.
-    let n = 7;
+    let n = 7i32;
     let x: Vec<[f64; 3]> = (0..n)
         .map(|i| [i as f64 / 3.0, -(i as f64).powi(5) * 1e-300, 0.0])
         .collect();
@@ -76,7 +79,7 @@ fn particles() -> (
     let s: Vec<Matrix2<f64>> = (0..n)
         .map(|i| Matrix2::new(1.0 / 7.0, i as f64, -(i as f64), std::f64::consts::PI))
         .collect();
-    let ids: Vec<i32> = (0..n as i32).map(|i| i % 3 - 1).collect();
+    let ids: Vec<i32> = (0..n).map(|i| i % 3 - 1).collect();
     let mut grid = UnstructuredGrid::point_cloud(x);
     grid.add_point_vectors("velocity", &v).unwrap();
     grid.add_point_tensors("stress", &s).unwrap();
