@@ -42,6 +42,17 @@ pub trait Constitutive<const D: usize>: Send + Sync + Debug {
     /// P-wave modulus λ + 2μ (the stiffness of longitudinal waves; E in 1D).
     fn p_wave_modulus(&self) -> f64;
 
+    /// Names of the scalars a particle's state carries, for output (plastic strain, …);
+    /// none for elastic models.
+    fn state_scalar_names(&self) -> &'static [&'static str] {
+        &[]
+    }
+
+    /// Appends the values of [`Self::state_scalar_names`] for `state` to `out`, in order.
+    fn state_scalars(&self, state: &Self::State, out: &mut Vec<f64>) {
+        let _ = (state, out);
+    }
+
     /// Cauchy stress σ = τ / J; needs det F > 0.
     fn cauchy_stress(
         &self,

@@ -161,6 +161,17 @@ impl<const D: usize, Y: YieldCriterion> Constitutive<D> for ElastoPlastic<Y> {
         PlasticState::default()
     }
 
+    fn state_scalar_names(&self) -> &'static [&'static str] {
+        &["plastic_strain", "plastic_jacobian"]
+    }
+
+    /// Accumulated equivalent plastic strain, and det Fᵖ (plastic volume change: > 1 for
+    /// a dilating Drucker–Prager material, 1 for J2).
+    fn state_scalars(&self, state: &PlasticState<D>, out: &mut Vec<f64>) {
+        out.push(state.accumulated_plastic_strain);
+        out.push(1.0 / crate::linalg::determinant(&state.plastic_inverse));
+    }
+
     fn return_map(
         &self,
         f: &Matrix<D>,

@@ -246,3 +246,28 @@ fn drucker_prager_closed_forms() {
         .sqrt();
     assert!(i1 < 0.0 && (dev / 2f64.sqrt() - (k - m.criterion.alpha() * i1)).abs() < 1e-8);
 }
+
+#[test]
+fn state_scalars_report_plastic_strain_and_volume_change() {
+    let f = pure_shear(0.01) * 1.002;
+    // J2 flow is isochoric: det Fᵖ stays 1 while plastic strain accumulates.
+    let m = j2(800.0);
+    let mut s = Constitutive::<3>::initial_state(&m);
+    m.return_map(&f, &mut s).unwrap();
+    let mut out = Vec::new();
+    Constitutive::<3>::state_scalars(&m, &s, &mut out);
+    assert_eq!(
+        Constitutive::<3>::state_scalar_names(&m),
+        ["plastic_strain", "plastic_jacobian"]
+    );
+    assert_eq!(out[0], s.accumulated_plastic_strain);
+    assert!(out[0] > 1e-4);
+    assert!((out[1] - 1.0).abs() < 1e-12, "{}", out[1]);
+    // Drucker–Prager with dilatancy: shear makes the material dilate plastically.
+    let m = dp(0.3);
+    let mut s = Constitutive::<3>::initial_state(&m);
+    m.return_map(&pure_shear(0.01), &mut s).unwrap();
+    out.clear();
+    Constitutive::<3>::state_scalars(&m, &s, &mut out);
+    assert!(out[0] > 0.0 && out[1] > 1.0, "{out:?}");
+}
