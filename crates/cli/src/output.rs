@@ -1,0 +1,142 @@
+//! The files a run writes: particle frames (`particles_NNNNN.vtu`) listed in
+//! `particles.pvd`, the mesh with grid fields (`mesh.vtu`), and the history (`history.csv`).
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::SVector;
+use umls_constitutive::Constitutive;
+use umls_engine::{Simulation, TransferScheme};
+use umls_io::gmsh::PhysicalGroup;
+use umls_io::vtk::{Collection, Encoding, UnstructuredGrid, pad_vector};
+use umls_mesh::SimplexMesh;
+use umls_transfer::Kernel;
+
+use crate::error::{CliError, Result};
+use crate::material::{MaterialTable, PlasticPart};
+
+/// The output directory of a run.
+#[derive(Debug)]
+pub struct OutputDir {
+    dir: PathBuf,
+    encoding: Encoding,
+    collection: Collection,
+}
+
+impl OutputDir {
+    /// Creates `dir` (and its parents).
+    pub fn create(dir: &Path, encoding: Encoding) -> Result<Self> {
+        std::fs::create_dir_all(dir).map_err(|source| CliError::File {
+            path: dir.to_path_buf(),
+            source,
+        })?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            encoding,
+            collection: Collection::default(),
+        })
+    }
+
+    /// A path inside the directory.
+    pub fn path(&self, name: &str) -> PathBuf {
+        self.dir.join(name)
+    }
+
+    /// Frames written so far.
+    pub fn frames(&self) -> usize {
+        self.collection.frames.len()
+    }
+
+    /// Writes one particle frame and rewrites `particles.pvd` to include it, so a run
+    /// stopped early still opens in ParaView.
+    pub fn write_particles<const D: usize, K, P, T>(
+        &mut self,
+        sim: &Simulation<D, K, MaterialTable<P>, T>,
+        reference_positions: &[SVector<f64, D>],
+    ) -> Result<()>
+    where
+        K: Kernel<D>,
+        P: PlasticPart<D>,
+        T: TransferScheme,
+    {
+        let p = &sim.particles;
+        let mut grid = UnstructuredGrid::point_cloud(p.position.iter().map(pad_vector).collect());
+        grid.add_point_vectors("velocity", &p.velocity)?;
+        let displacement: Vec<SVector<f64, D>> = p
+            .position
+            .iter()
+            .zip(reference_positions)
+            .map(|(x, x0)| x - x0)
+            .collect();
+        grid.add_point_vectors("displacement", &displacement)?;
+        let kirchhoff = sim.stresses()?;
+        let jacobian: Vec<f64> = p.deformation.iter().map(umls_constitutive::determinant).collect();
+        let cauchy: Vec<_> = kirchhoff.iter().zip(&jacobian).map(|(t, j)| t / *j).collect();
+        grid.add_point_tensors("cauchy_stress", &cauchy)?;
+        grid.add_point_field(
+            "mean_stress",
+            1,
+            cauchy.iter().map(|s| s.trace() / D as f64).collect(),
+        )?;
+        grid.add_point_tensors("deformation_gradient", &p.deformation)?;
+        grid.add_point_field("jacobian", 1, jacobian)?;
+        grid.add_point_field("mass", 1, p.mass.clone())?;
+        grid.add_point_ids(
+            "material",
+            p.state.iter().map(|s| i32::from(s.material)).collect(),
+        )?;
+        let names = sim.material.state_scalar_names();
+        if !names.is_empty() {
+            let mut values = Vec::with_capacity(p.len() * names.len());
+            for s in &p.state {
+                sim.material.state_scalars(s, &mut values);
+            }
+            for (k, name) in names.iter().enumerate() {
+                let column = values.iter().skip(k).step_by(names.len()).copied().collect();
+                grid.add_point_field(name, 1, column)?;
+            }
+        }
+        let name = format!("particles_{:05}.vtu", self.frames());
+        grid.write_vtu(self.path(&name), self.encoding)?;
+        self.collection.push(sim.time(), name);
+        self.collection.write(self.path("particles.pvd"))?;
+        Ok(())
+    }
+
+    /// Writes `mesh.vtu`: the mesh, its physical groups as 0/1 fields, cell quality, and
+    /// (for mesh kernels) the last step's nodal mass and velocity.
+    pub fn write_mesh<const D: usize>(
+        &self,
+        mesh: &SimplexMesh<D>,
+        groups: &[PhysicalGroup],
+        grid_fields: Option<(&[f64], &[SVector<f64, D>])>,
+    ) -> Result<()> {
+        let mut grid = UnstructuredGrid::from_mesh(mesh);
+        if let Some((mass, velocity)) = grid_fields {
+            grid.add_point_field("node_mass", 1, mass.to_vec())?;
+            grid.add_point_vectors("node_velocity", velocity)?;
+        }
+        grid.add_cell_field(
+            "radius_ratio",
+            1,
+            (0..mesh.simplex_count())
+                .map(|s| mesh.simplex_quality(s).radius_ratio)
+                .collect(),
+        )?;
+        for g in groups {
+            let mut flags = vec![0; mesh.vertex_count()];
+            for &v in &g.vertices {
+                flags[v as usize] = 1;
+            }
+            grid.add_point_ids(&format!("group {}", g.name), flags)?;
+            if g.dimension == D {
+                let mut cells = vec![0; mesh.simplex_count()];
+                for &c in &g.cells {
+                    cells[c as usize] = 1;
+                }
+                grid.add_cell_ids(&format!("group {}", g.name), cells)?;
+            }
+        }
+        grid.write_vtu(self.path("mesh.vtu"), self.encoding)?;
+        Ok(())
+    }
+}

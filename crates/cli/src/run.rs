@@ -1,0 +1,445 @@
+//! `umls run`: build the scene for its dimension, pick the kernel, material table and
+//! transfer types, step to the end time and write the output.
+//!
+//! Each (dimension, kernel, transfer, plasticity) combination is its own monomorphized
+//! simulation, so a run executes exactly the code its scene needs.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use nalgebra::SVector;
+use serde_json::json;
+use umls_engine::{
+    Apic, Diagnostics, Flip, Particles, Pic, Simulation, StepSettings, TransferScheme,
+    VelocityGradientAffine,
+};
+use umls_io::csv::HistoryWriter;
+use umls_io::vtk::Encoding;
+use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, Umls1, Umls2, Umls3};
+use umls_mesh::generate::{Diagonal, Lattice};
+use umls_mesh::{MeshError, SimplexMesh};
+use umls_transfer::Kernel;
+
+use crate::error::{CliError, Result};
+use crate::material::{MaterialTable, Model, NoPlasticity, PlasticModel, PlasticPart, TableState};
+use crate::output::OutputDir;
+use crate::progress::Progress;
+use crate::scene::Scene;
+use crate::schema::{BoundaryKind, KernelKind, TransferKind};
+use crate::setup::{self, BoundaryTarget, Setup, Split};
+
+/// Command-line overrides and output settings of a run.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// Kernel instead of the scene's.
+    pub kernel: Option<KernelKind>,
+    /// Output directory.
+    pub out: PathBuf,
+    /// End time instead of the scene's.
+    pub end_time: Option<f64>,
+    /// Worker threads (default: all cores).
+    pub threads: Option<usize>,
+    /// Show a progress bar.
+    pub progress: bool,
+}
+
+/// What a finished run reports.
+#[derive(Debug, Clone)]
+pub struct RunReport {
+    /// The contents of `summary.json`.
+    pub summary: serde_json::Value,
+    /// Where the files are.
+    pub out: PathBuf,
+}
+
+/// What differs between dimensions: the UMLS kernel type, the lattice split, and
+/// whether plastic models exist.
+trait Dimension<const D: usize> {
+    type Umls: Kernel<D>;
+    const SPLIT: Split<D>;
+    fn umls(mesh: Arc<SimplexMesh<D>>) -> Self::Umls;
+    fn run_plastic<K: Kernel<D>>(ctx: &Context<'_, D>, kernel: K) -> Result<RunReport>;
+}
+
+struct D1;
+struct D2;
+struct D3;
+
+fn split1(l: &Lattice<1>, _: Diagonal) -> std::result::Result<SimplexMesh<1>, MeshError> {
+    l.segments()
+}
+fn split2(l: &Lattice<2>, d: Diagonal) -> std::result::Result<SimplexMesh<2>, MeshError> {
+    l.triangles(d)
+}
+fn split3(l: &Lattice<3>, _: Diagonal) -> std::result::Result<SimplexMesh<3>, MeshError> {
+    l.tetrahedra()
+}
+
+impl Dimension<1> for D1 {
+    type Umls = Umls1;
+    const SPLIT: Split<1> = split1;
+    fn umls(mesh: Arc<SimplexMesh<1>>) -> Umls1 {
+        Umls1::new(mesh)
+    }
+    fn run_plastic<K: Kernel<1>>(ctx: &Context<'_, 1>, _: K) -> Result<RunReport> {
+        Err(setup::plastic_in_1d(ctx.scene))
+    }
+}
+
+impl Dimension<2> for D2 {
+    type Umls = Umls2;
+    const SPLIT: Split<2> = split2;
+    fn umls(mesh: Arc<SimplexMesh<2>>) -> Umls2 {
+        Umls2::new(mesh)
+    }
+    fn run_plastic<K: Kernel<2>>(ctx: &Context<'_, 2>, kernel: K) -> Result<RunReport> {
+        with_material(ctx, kernel, MaterialTable::<PlasticModel> { models: ctx.setup.models.clone() })
+    }
+}
+
+impl Dimension<3> for D3 {
+    type Umls = Umls3;
+    const SPLIT: Split<3> = split3;
+    fn umls(mesh: Arc<SimplexMesh<3>>) -> Umls3 {
+        Umls3::new(mesh)
+    }
+    fn run_plastic<K: Kernel<3>>(ctx: &Context<'_, 3>, kernel: K) -> Result<RunReport> {
+        with_material(ctx, kernel, MaterialTable::<PlasticModel> { models: ctx.setup.models.clone() })
+    }
+}
+
+/// Everything the typed part of a run reads.
+struct Context<'a, const D: usize> {
+    scene: &'a Scene,
+    setup: Setup<D>,
+    options: &'a RunOptions,
+    kernel: KernelKind,
+    end_time: f64,
+    encoding: Encoding,
+}
+
+/// Runs `scene` with `options`.
+pub fn run(scene: &Scene, options: &RunOptions) -> Result<RunReport> {
+    setup::check_header(scene)?;
+    if let Some(t) = options.end_time {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(scene.value_error("--end-time", "must be finite and positive"));
+        }
+    }
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = options.threads {
+        if n == 0 {
+            return Err(scene.value_error("--threads", "must be at least 1"));
+        }
+        pool = pool.num_threads(n);
+    }
+    let pool = pool
+        .build()
+        .map_err(|e| scene.value_error("--threads", e.to_string()))?;
+    pool.install(|| match scene.spec.scene.dimension {
+        1 => run_dim::<1, D1>(scene, options),
+        2 => run_dim::<2, D2>(scene, options),
+        _ => run_dim::<3, D3>(scene, options),
+    })
+}
+
+fn run_dim<const D: usize, X: Dimension<D>>(scene: &Scene, options: &RunOptions) -> Result<RunReport> {
+    let setup = setup::build::<D>(scene, X::SPLIT)?;
+    let encoding = match scene.spec.output.encoding.as_deref().unwrap_or("binary") {
+        "binary" => Encoding::Binary,
+        "ascii" => Encoding::Ascii,
+        other => return Err(scene.value_error("output.encoding", format!("`{other}`: expected binary or ascii"))),
+    };
+    let ctx = Context {
+        scene,
+        kernel: options.kernel.unwrap_or(scene.spec.kernel.kind),
+        end_time: options.end_time.unwrap_or(scene.spec.scene.end_time),
+        setup,
+        options,
+        encoding,
+    };
+    let mesh = ctx.setup.mesh.clone();
+    match ctx.kernel {
+        KernelKind::Umls => with_kernel::<D, X, _>(&ctx, X::umls(mesh)),
+        KernelKind::LinearFe => with_kernel::<D, X, _>(&ctx, LinearFeKernel::new(mesh)),
+        KernelKind::Bspline2 => with_kernel::<D, X, _>(&ctx, bspline(&ctx, BSplineOrder::Quadratic)?),
+        KernelKind::Bspline3 => with_kernel::<D, X, _>(&ctx, bspline(&ctx, BSplineOrder::Cubic)?),
+    }
+}
+
+/// A B-spline grid covering the mesh's bounding box with two cells of margin (the
+/// widest, cubic, stencil needs one).
+fn bspline<const D: usize>(ctx: &Context<'_, D>, order: BSplineOrder) -> Result<BSplineKernel<D>> {
+    const MARGIN: usize = 2;
+    let mesh = &ctx.setup.mesh;
+    let h = ctx
+        .scene
+        .spec
+        .kernel
+        .grid_spacing
+        .or(ctx.setup.lattice_spacing)
+        .unwrap_or_else(|| mesh.max_edge_length() / (D as f64).sqrt());
+    if !(h.is_finite() && h > 0.0) {
+        return Err(ctx.scene.value_error("kernel.grid_spacing", "must be positive"));
+    }
+    let (lower, upper) = mesh.bounding_box();
+    let origin = lower.add_scalar(-(MARGIN as f64) * h);
+    let cells: [usize; D] = std::array::from_fn(|k| ((upper[k] - lower[k]) / h - 1e-9).ceil().max(1.0) as usize + 2 * MARGIN);
+    BSplineKernel::new(origin, h, cells, order)
+        .ok_or_else(|| ctx.scene.value_error("kernel.grid_spacing", "too coarse for one B-spline stencil"))
+}
+
+fn with_kernel<const D: usize, X: Dimension<D>, K: Kernel<D>>(ctx: &Context<'_, D>, kernel: K) -> Result<RunReport> {
+    if ctx.setup.has_plasticity() {
+        return X::run_plastic(ctx, kernel);
+    }
+    let models = ctx
+        .setup
+        .models
+        .iter()
+        .filter_map(|m| match m {
+            Model::Elastic(e) => Some(Model::<NoPlasticity>::Elastic(e.clone())),
+            Model::Plastic(_) => None,
+        })
+        .collect();
+    with_material(ctx, kernel, MaterialTable::<NoPlasticity> { models })
+}
+
+fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
+    ctx: &Context<'_, D>,
+    kernel: K,
+    table: MaterialTable<P>,
+) -> Result<RunReport> {
+    let t = &ctx.scene.spec.transfer;
+    match t.kind {
+        TransferKind::Pic => simulate(ctx, kernel, table, Pic),
+        TransferKind::Flip => simulate(ctx, kernel, table, Flip { alpha: t.alpha }),
+        TransferKind::Apic => simulate(ctx, kernel, table, Apic),
+        TransferKind::VelocityGradient => simulate(ctx, kernel, table, VelocityGradientAffine),
+    }
+}
+
+fn transfer_name(spec: &crate::schema::TransferSpec) -> String {
+    match spec.kind {
+        TransferKind::Pic => "pic".into(),
+        TransferKind::Flip => format!("flip (alpha {})", spec.alpha),
+        TransferKind::Apic => "apic".into(),
+        TransferKind::VelocityGradient => "velocity-gradient".into(),
+    }
+}
+
+/// Energy with the gravitational potential −Σ m g·x, so that gravity scenes conserve it too.
+fn total_energy<const D: usize>(d: &Diagnostics<D>, gravity: &SVector<f64, D>, positions: &[SVector<f64, D>], mass: &[f64]) -> (f64, f64) {
+    let potential: f64 = if gravity.norm() == 0.0 {
+        0.0
+    } else {
+        -positions.iter().zip(mass).map(|(x, m)| m * gravity.dot(x)).sum::<f64>()
+    };
+    (potential, d.total_energy() + potential)
+}
+
+fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
+    ctx: &Context<'_, D>,
+    kernel: K,
+    table: MaterialTable<P>,
+    transfer: T,
+) -> Result<RunReport> {
+    let (scene, setup, spec) = (ctx.scene, &ctx.setup, &ctx.scene.spec);
+    let seeds = &setup.seeds;
+    let mut particles = Particles::<D, TableState<P::State>, K::Cache>::at_rest(
+        seeds.position.clone(),
+        seeds.volume.clone(),
+        1.0,
+        TableState::default(),
+    );
+    particles.mass.clone_from(&seeds.mass);
+    particles.velocity.clone_from(&seeds.velocity);
+    for (state, &m) in particles.state.iter_mut().zip(&seeds.material) {
+        state.material = m;
+    }
+    let mut settings = StepSettings::new(1.0);
+    settings.gravity = setup.gravity;
+    settings.stress_update = setup.stress_update;
+    let mut sim = Simulation::new(kernel, table, transfer, particles, settings)?;
+
+    let target_dt = match (spec.time.dt, spec.time.cfl) {
+        (Some(dt), _) => dt,
+        (_, Some(cfl)) => sim.stable_time_step(cfl),
+        _ => unreachable_dt(scene)?,
+    };
+    let steps = ((ctx.end_time / target_dt) - 1e-9).ceil().max(1.0) as usize;
+    sim.settings.dt = ctx.end_time / steps as f64;
+
+    let mesh_kernel = matches!(ctx.kernel, KernelKind::Umls | KernelKind::LinearFe);
+    for (i, (kind, target)) in setup.boundaries.iter().enumerate() {
+        match target {
+            BoundaryTarget::Plane { point, normal } => {
+                let tolerance = 1e-6 * sim.kernel.spacing();
+                let nodes = umls_engine::Boundary::nodes_on_plane(&sim.kernel, point, normal, tolerance);
+                if nodes.is_empty() {
+                    return Err(scene.value_error(format!("boundaries[{i}].plane"), format!("no {} node lies on the plane", ctx.kernel.name())));
+                }
+                match kind {
+                    BoundaryKind::Fixed => sim.boundary.fixed.extend(nodes),
+                    BoundaryKind::Slip => sim.boundary.slip.extend(nodes.into_iter().map(|n| (n, *normal))),
+                }
+            }
+            BoundaryTarget::Vertices(vertices) => {
+                if !mesh_kernel {
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].group"),
+                        format!("a group condition needs mesh nodes; the {} kernel uses a grid (use a plane)", ctx.kernel.name()),
+                    ));
+                }
+                match kind {
+                    BoundaryKind::Fixed => sim.boundary.fixed.extend(vertices.iter().map(|(v, _)| *v)),
+                    BoundaryKind::Slip => sim.boundary.slip.extend(vertices.iter().copied()),
+                }
+            }
+        }
+    }
+
+    let mut out = OutputDir::create(&ctx.options.out, ctx.encoding)?;
+    let axes = ["x", "y", "z"];
+    let mut header: Vec<String> = ["step", "time", "kinetic", "elastic", "potential", "total"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    header.extend((0..D).map(|k| format!("momentum_{}", axes[k])));
+    header.extend(["mass", "max_speed", "courant"].map(String::from));
+    if setup.reference.is_some() {
+        header.push("velocity_error".into());
+    }
+    let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
+    let mut history = HistoryWriter::create(out.path("history.csv"), &header_refs)?;
+
+    let reference_positions = seeds.position.clone();
+    let frames = spec.output.frames;
+    let frame_time = |k: usize| ctx.end_time * k as f64 / (frames - 1) as f64;
+    let mut next_frame = 1;
+    let record = |sim: &Simulation<D, K, MaterialTable<P>, T>, history: &mut HistoryWriter, error: Option<f64>| -> Result<(f64, Diagnostics<D>)> {
+        let d = sim.diagnostics()?;
+        let (potential, total) = total_energy(&d, &setup.gravity, &sim.particles.position, &sim.particles.mass);
+        let mut row = vec![d.step as f64, d.time, d.kinetic, d.elastic, potential, total];
+        row.extend(d.momentum.iter());
+        row.extend([d.mass, d.max_speed, d.courant]);
+        row.extend(error);
+        history.row(&row)?;
+        Ok((total, d))
+    };
+
+    // The reference error at the current time: RMS over particles of |v − v_ref(X, t)|.
+    let reference_error = |sim: &Simulation<D, K, MaterialTable<P>, T>| -> Result<Option<f64>> {
+        let Some((field, scale)) = &setup.reference else {
+            return Ok(None);
+        };
+        let mut sum = 0.0;
+        for (v, x0) in sim.particles.velocity.iter().zip(&reference_positions) {
+            let exact = field
+                .eval(x0, sim.time())
+                .map_err(|reason| scene.value_error("reference.velocity", reason))?;
+            sum += (v - exact).norm_squared();
+        }
+        Ok(Some((sum / sim.particles.len() as f64).sqrt() / scale))
+    };
+
+    out.write_particles(&sim, &reference_positions)?;
+    let (e0, d0) = record(&sim, &mut history, reference_error(&sim)?)?;
+    // Energy error: the largest |E(t) − E(0)| over the largest mechanical energy
+    // (kinetic + elastic) of the run, which stays meaningful when E(0) is 0 (a body
+    // released from rest under gravity).
+    let (mut energy_change, mut energy_scale) = (0.0f64, d0.kinetic + d0.elastic);
+    let (mut error_sum, mut error_max) = (0.0f64, 0.0f64);
+    let progress = Progress::new(ctx.options.progress, steps as u64, &spec.scene.name);
+    let start = Instant::now();
+    let mut failure: Option<CliError> = None;
+    let mut last = d0;
+    let mut last_total = e0;
+    for step in 1..=steps {
+        if let Err(e) = sim.step() {
+            failure = Some(e.into());
+            break;
+        }
+        let error = reference_error(&sim)?;
+        if let Some(e) = error {
+            error_sum += e * e;
+            error_max = error_max.max(e);
+        }
+        if step % spec.output.history_every == 0 || step == steps {
+            let (total, d) = record(&sim, &mut history, error)?;
+            energy_change = energy_change.max((total - e0).abs());
+            last_total = total;
+            energy_scale = energy_scale.max(d.kinetic + d.elastic);
+            last = d;
+        }
+        if next_frame < frames && sim.time() >= frame_time(next_frame) - 0.5 * sim.settings.dt {
+            out.write_particles(&sim, &reference_positions)?;
+            next_frame += 1;
+        }
+        progress.advance();
+    }
+    let wall = start.elapsed().as_secs_f64();
+    progress.finish();
+    history.flush()?;
+    let (mass, velocity) = sim.grid();
+    if mesh_kernel {
+        out.write_mesh(&setup.mesh, &setup.groups, Some((mass, velocity)))?;
+    } else {
+        out.write_mesh(&setup.mesh, &setup.groups, None)?;
+    }
+    let taken = sim.step_count();
+    let mut metrics = serde_json::Map::new();
+    let energy_error = if energy_scale > 0.0 { energy_change / energy_scale } else { 0.0 };
+    metrics.insert("energy_error".into(), json!(energy_error));
+    metrics.insert("initial_energy".into(), json!(e0));
+    metrics.insert("final_energy".into(), json!(last_total));
+    metrics.insert("momentum_change".into(), json!((last.momentum - d0.momentum).norm()));
+    if setup.reference.is_some() && taken > 0 {
+        metrics.insert("velocity_rmse".into(), json!((error_sum / taken as f64).sqrt()));
+        metrics.insert("velocity_error_max".into(), json!(error_max));
+    }
+    let summary = json!({
+        "scene": spec.scene.name,
+        "source": scene.label,
+        "dimension": D,
+        "kernel": ctx.kernel.name(),
+        "transfer": transfer_name(&spec.transfer),
+        "stress_update": spec.time.stress_update.as_deref().unwrap_or("usl"),
+        "materials": setup.material_names,
+        "particles": sim.particles.len(),
+        "nodes": sim.kernel.node_count(),
+        "cells": setup.mesh.simplex_count(),
+        "dt": sim.settings.dt,
+        "end_time": ctx.end_time,
+        "steps_planned": steps,
+        "steps": taken,
+        "threads": rayon::current_num_threads(),
+        "status": if failure.is_some() { "failed" } else { "completed" },
+        "error": failure.as_ref().map(|e| e.to_string()),
+        "wall_time_s": wall,
+        "particle_steps_per_second": if wall > 0.0 { (sim.particles.len() * taken) as f64 / wall } else { 0.0 },
+        "metrics": metrics,
+        "outputs": {
+            "particles": "particles.pvd",
+            "frames": out.frames(),
+            "mesh": "mesh.vtu",
+            "history": "history.csv",
+        },
+    });
+    let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
+    let path = out.path("summary.json");
+    std::fs::write(&path, text + "\n").map_err(|source| CliError::File { path, source })?;
+    match failure {
+        Some(e) => Err(e),
+        None => Ok(RunReport {
+            summary,
+            out: ctx.options.out.clone(),
+        }),
+    }
+}
+
+/// `check_header` guarantees a time step setting; this keeps the match total without a panic.
+fn unreachable_dt(scene: &Scene) -> Result<f64> {
+    Err(scene.value_error("time", "give exactly one of `dt` and `cfl`"))
+}

@@ -1,0 +1,82 @@
+//! Loading a scene: a built-in name or a TOML file, parsed into a [`SceneSpec`] and checked.
+
+use std::path::{Path, PathBuf};
+
+use crate::builtin::BUILTIN;
+use crate::error::{CliError, Result};
+use crate::schema::SceneSpec;
+
+/// A parsed scene and where it came from.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// The parsed file.
+    pub spec: SceneSpec,
+    /// The file path or built-in name, for messages.
+    pub label: String,
+    /// Directory that relative mesh paths start from (`None` for built-in scenes, whose
+    /// meshes are embedded).
+    pub base_dir: Option<PathBuf>,
+}
+
+impl Scene {
+    /// Parses scene text; `label` names it in errors.
+    pub fn parse(text: &str, label: &str, base_dir: Option<PathBuf>) -> Result<Self> {
+        let spec: SceneSpec = toml::from_str(text).map_err(|e| CliError::SceneSyntax {
+            file: label.to_string(),
+            message: e.to_string(),
+        })?;
+        Ok(Self {
+            spec,
+            label: label.to_string(),
+            base_dir,
+        })
+    }
+
+    /// A built-in scene by name, or else a scene file at that path.
+    pub fn load(name_or_path: &str) -> Result<Self> {
+        if let Some(builtin) = BUILTIN.iter().find(|b| b.name == name_or_path) {
+            return Self::parse(builtin.toml, builtin.name, None);
+        }
+        let path = Path::new(name_or_path);
+        if !path.is_file() {
+            return Err(CliError::UnknownScene {
+                name: name_or_path.to_string(),
+                known: BUILTIN
+                    .iter()
+                    .map(|b| b.name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        }
+        let text = std::fs::read_to_string(path).map_err(|source| CliError::File {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let base = path.parent().map(Path::to_path_buf);
+        Self::parse(&text, &path.display().to_string(), base)
+    }
+
+    /// An error about `key`.
+    pub fn value_error(&self, key: impl Into<String>, reason: impl Into<String>) -> CliError {
+        CliError::SceneValue {
+            file: self.label.clone(),
+            key: key.into(),
+            reason: reason.into(),
+        }
+    }
+
+    /// The bytes of the mesh file named in `[mesh] file`.
+    pub fn mesh_bytes(&self, file: &str) -> Result<Vec<u8>> {
+        match &self.base_dir {
+            None => crate::builtin::MESHES
+                .iter()
+                .find(|(name, _)| *name == file)
+                .map(|(_, bytes)| bytes.to_vec())
+                .ok_or_else(|| self.value_error("mesh.file", format!("no embedded mesh `{file}`"))),
+            Some(dir) => {
+                let path = dir.join(file);
+                std::fs::read(&path).map_err(|source| CliError::File { path, source })
+            }
+        }
+    }
+}

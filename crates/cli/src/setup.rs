@@ -1,0 +1,448 @@
+//! From a parsed scene to the pieces of a D-dimensional simulation: mesh, particles,
+//! materials, boundary conditions, time step and the optional reference solution.
+
+use std::sync::Arc;
+
+use nalgebra::SVector;
+use umls_constitutive::{
+    ConeFit, DruckerPrager, ElasticParameters, ElastoPlastic, FixedCorotated, LinearElastic,
+    NeoHookean, StVenantKirchhoff, VonMises, WeaklyCompressibleFluid,
+};
+use umls_engine::{Region, StressUpdate, lattice_samples};
+use umls_io::gmsh::{PhysicalGroup, ReadOptions, parse_msh};
+use umls_mesh::generate::{Diagonal, Lattice};
+use umls_mesh::{Orientation, SampleRule, SimplexMesh};
+
+use crate::error::{CliError, Result};
+use crate::expression::VectorField;
+use crate::material::{ElasticModel, Model, PlasticModel};
+use crate::scene::Scene;
+use crate::schema::{BoundaryKind, RegionSpec, SeedingSpec};
+
+/// Particles as plain arrays, before they meet a kernel and a material type.
+#[derive(Debug, Clone, Default)]
+pub struct Seeds<const D: usize> {
+    /// Positions.
+    pub position: Vec<SVector<f64, D>>,
+    /// Reference volumes.
+    pub volume: Vec<f64>,
+    /// Masses.
+    pub mass: Vec<f64>,
+    /// Initial velocities.
+    pub velocity: Vec<SVector<f64, D>>,
+    /// Material index.
+    pub material: Vec<u16>,
+}
+
+/// A boundary condition resolved to geometry.
+#[derive(Debug, Clone)]
+pub enum BoundaryTarget<const D: usize> {
+    /// Nodes on the plane through `point` with unit `normal`.
+    Plane {
+        /// Point on the plane.
+        point: SVector<f64, D>,
+        /// Unit normal.
+        normal: SVector<f64, D>,
+    },
+    /// These mesh vertices (with their outward normals, for slip).
+    Vertices(Vec<(u32, SVector<f64, D>)>),
+}
+
+/// Everything a D-dimensional run needs besides the kernel, material and transfer types.
+#[derive(Debug, Clone)]
+pub struct Setup<const D: usize> {
+    /// The background mesh.
+    pub mesh: Arc<SimplexMesh<D>>,
+    /// Cell size of a lattice mesh (B-spline grids default to it).
+    pub lattice_spacing: Option<f64>,
+    /// Physical groups of a file mesh.
+    pub groups: Vec<PhysicalGroup>,
+    /// The particles.
+    pub seeds: Seeds<D>,
+    /// Material models, by index.
+    pub models: Vec<Model<PlasticModel>>,
+    /// Material names, by index.
+    pub material_names: Vec<String>,
+    /// Boundary conditions.
+    pub boundaries: Vec<(BoundaryKind, BoundaryTarget<D>)>,
+    /// Gravity.
+    pub gravity: SVector<f64, D>,
+    /// USL or MUSL.
+    pub stress_update: StressUpdate,
+    /// The analytic velocity v(X, t), and the scale its RMSE is divided by.
+    pub reference: Option<(VectorField<D>, f64)>,
+}
+
+impl<const D: usize> Setup<D> {
+    /// Whether any material is plastic.
+    pub fn has_plasticity(&self) -> bool {
+        self.models.iter().any(|m| matches!(m, Model::Plastic(_)))
+    }
+}
+
+fn vector<const D: usize>(scene: &Scene, key: &str, values: &[f64]) -> Result<SVector<f64, D>> {
+    if values.len() != D {
+        return Err(scene.value_error(
+            key,
+            format!("{} components given, the scene is {D}-dimensional", values.len()),
+        ));
+    }
+    if values.iter().any(|v| !v.is_finite()) {
+        return Err(scene.value_error(key, "components must be finite"));
+    }
+    Ok(SVector::from_fn(|k, _| values[k]))
+}
+
+/// Splits a lattice into simplices (segments, triangles with the given diagonals, or
+/// tetrahedra); the generator's split exists per dimension, so the caller supplies it.
+pub type Split<const D: usize> = fn(&Lattice<D>, Diagonal) -> std::result::Result<SimplexMesh<D>, umls_mesh::MeshError>;
+
+fn mesh<const D: usize>(
+    scene: &Scene,
+    split: Split<D>,
+) -> Result<(SimplexMesh<D>, Option<f64>, Vec<PhysicalGroup>)> {
+    let spec = &scene.spec.mesh;
+    match (&spec.file, &spec.lattice) {
+        (Some(file), None) => {
+            let options = ReadOptions {
+                orientation: if spec.reject_inverted {
+                    Orientation::Reject
+                } else {
+                    Orientation::Fix
+                },
+            };
+            let read = parse_msh::<D>(&scene.mesh_bytes(file)?, options)
+                .map_err(|e| scene.value_error("mesh.file", format!("{file}: {e}")))?;
+            Ok((read.mesh, None, read.groups))
+        }
+        (None, Some(l)) => {
+            let lower: SVector<f64, D> = vector(scene, "mesh.lattice.lower", &l.lower)?;
+            let upper: SVector<f64, D> = vector(scene, "mesh.lattice.upper", &l.upper)?;
+            if l.cells.len() != D {
+                return Err(scene.value_error("mesh.lattice.cells", format!("needs {D} counts")));
+            }
+            let cells: [usize; D] = std::array::from_fn(|k| l.cells[k]);
+            let spacing = (0..D)
+                .map(|k| (upper[k] - lower[k]) / cells[k].max(1) as f64)
+                .fold(f64::INFINITY, f64::min);
+            let lattice = Lattice::new(lower.into(), upper.into(), cells).jitter(l.jitter, l.seed);
+            let diagonal = match l.diagonal.as_deref() {
+                None | Some("alternating") => Diagonal::Alternating,
+                Some(_) if D != 2 => {
+                    return Err(scene.value_error("mesh.lattice.diagonal", "only 2D lattices have diagonals"));
+                }
+                Some("right") => Diagonal::Right,
+                Some("left") => Diagonal::Left,
+                Some("crossed") => Diagonal::Crossed,
+                Some(other) => {
+                    return Err(scene.value_error(
+                        "mesh.lattice.diagonal",
+                        format!("`{other}`: expected right, left, alternating or crossed"),
+                    ));
+                }
+            };
+            let mesh = split(&lattice, diagonal)
+                .map_err(|e| scene.value_error("mesh.lattice", e.to_string()))?;
+            Ok((mesh, Some(spacing), Vec::new()))
+        }
+        _ => Err(scene.value_error("mesh", "give exactly one of `file` and `lattice`")),
+    }
+}
+
+fn material(scene: &Scene, index: usize) -> Result<Model<PlasticModel>> {
+    let m = &scene.spec.materials[index];
+    let key = |field: &str| format!("materials[{index}].{field}");
+    let need = |value: Option<f64>, field: &str| {
+        value.ok_or_else(|| scene.value_error(key(field), format!("required by model `{}`", m.model)))
+    };
+    let bad = |field: &str, e: umls_constitutive::ConstitutiveError| scene.value_error(key(field), e.to_string());
+    if !(m.density.is_finite() && m.density > 0.0) {
+        return Err(scene.value_error(key("density"), "must be finite and positive"));
+    }
+    let elastic = || {
+        ElasticParameters::from_young_poisson(need(m.young, "young")?, need(m.poisson, "poisson")?)
+            .map_err(|e| bad("young", e))
+    };
+    let degrees = |v: f64| v.to_radians();
+    Ok(match m.model.as_str() {
+        "linear-elastic" => Model::Elastic(ElasticModel::Linear(LinearElastic { parameters: elastic()? })),
+        "neo-hookean" => Model::Elastic(ElasticModel::NeoHookean(NeoHookean { parameters: elastic()? })),
+        "st-venant-kirchhoff" => Model::Elastic(ElasticModel::StVenantKirchhoff(StVenantKirchhoff {
+            parameters: elastic()?,
+        })),
+        "fixed-corotated" => Model::Elastic(ElasticModel::Corotated(FixedCorotated { parameters: elastic()? })),
+        "fluid" => Model::Elastic(ElasticModel::Fluid(
+            WeaklyCompressibleFluid::new(need(m.bulk, "bulk")?, m.gamma.unwrap_or(7.0))
+                .map_err(|e| bad("bulk", e))?,
+        )),
+        "drucker-prager" => {
+            let criterion = DruckerPrager::from_mohr_coulomb(
+                need(m.cohesion, "cohesion")?,
+                degrees(need(m.friction_angle, "friction_angle")?),
+                degrees(m.dilatancy_angle.unwrap_or(0.0)),
+                ConeFit::PlaneStrain,
+            )
+            .map_err(|e| bad("friction_angle", e))?;
+            Model::Plastic(PlasticModel::DruckerPrager(ElastoPlastic::new(elastic()?, criterion)))
+        }
+        "von-mises" => {
+            let criterion = VonMises::new(need(m.yield_stress, "yield_stress")?, m.hardening.unwrap_or(0.0))
+                .map_err(|e| bad("yield_stress", e))?;
+            Model::Plastic(PlasticModel::VonMises(ElastoPlastic::new(elastic()?, criterion)))
+        }
+        other => {
+            return Err(scene.value_error(
+                key("model"),
+                format!(
+                    "`{other}`: expected linear-elastic, neo-hookean, st-venant-kirchhoff, fixed-corotated, fluid, drucker-prager or von-mises"
+                ),
+            ));
+        }
+    })
+}
+
+fn group<'a>(scene: &Scene, groups: &'a [PhysicalGroup], key: &str, name: &str) -> Result<&'a PhysicalGroup> {
+    groups.iter().find(|g| g.name == name).ok_or_else(|| {
+        let known: Vec<&str> = groups.iter().map(|g| g.name.as_str()).collect();
+        scene.value_error(
+            key,
+            if known.is_empty() {
+                format!("no physical group `{name}`: the mesh has none (only Gmsh files do)")
+            } else {
+                format!("no physical group `{name}` (the mesh has: {})", known.join(", "))
+            },
+        )
+    })
+}
+
+fn seed_body<const D: usize>(
+    scene: &Scene,
+    index: usize,
+    mesh: &SimplexMesh<D>,
+    groups: &[PhysicalGroup],
+    material: u16,
+    seeds: &mut Seeds<D>,
+) -> Result<()> {
+    let body = &scene.spec.bodies[index];
+    let key = |field: &str| format!("bodies[{index}].{field}");
+    let density = scene.spec.materials[material as usize].density;
+    let mut cells: Option<&[u32]> = None;
+    let region: Region<D> = match &body.region {
+        None | Some(RegionSpec::Everywhere(true)) => Region::Everywhere,
+        Some(RegionSpec::Everywhere(false)) => {
+            return Err(scene.value_error(key("region.everywhere"), "`false` selects nothing; omit the region instead"));
+        }
+        Some(RegionSpec::Box { lower, upper }) => Region::Box {
+            lower: vector(scene, &key("region.box.lower"), lower)?,
+            upper: vector(scene, &key("region.box.upper"), upper)?,
+        },
+        Some(RegionSpec::Ball { centre, radius }) => Region::Ball {
+            centre: vector(scene, &key("region.ball.centre"), centre)?,
+            radius: *radius,
+        },
+        Some(RegionSpec::HalfSpace { normal, offset }) => Region::HalfSpace {
+            normal: vector(scene, &key("region.half-space.normal"), normal)?,
+            offset: *offset,
+        },
+        Some(RegionSpec::Group(name)) => {
+            let g = group(scene, groups, &key("region.group"), name)?;
+            if g.dimension != D {
+                return Err(scene.value_error(key("region.group"), format!("`{name}` is a {}D group; a body needs {D}D cells", g.dimension)));
+            }
+            cells = Some(&g.cells);
+            Region::Everywhere
+        }
+    };
+    let samples: Vec<(SVector<f64, D>, f64)> = match &body.seeding {
+        SeedingSpec::Lattice(h) => {
+            if cells.is_some() {
+                return Err(scene.value_error(key("seeding"), "a group region needs mesh seeding (`centroid` or `gauss2`)"));
+            }
+            if !(h.is_finite() && *h > 0.0) {
+                return Err(scene.value_error(key("seeding.lattice"), "spacing must be positive"));
+            }
+            let (lower, upper) = mesh.bounding_box();
+            lattice_samples(lower, upper, *h)
+        }
+        SeedingSpec::Mesh(rule) => {
+            let rule = match rule.as_str() {
+                "centroid" => SampleRule::Centroid,
+                "gauss2" => SampleRule::Gauss2,
+                other => return Err(scene.value_error(key("seeding.mesh"), format!("`{other}`: expected centroid or gauss2"))),
+            };
+            let all = mesh.sample_points(rule);
+            match cells {
+                None => all,
+                Some(cells) => {
+                    let per = rule.count(D);
+                    cells
+                        .iter()
+                        .flat_map(|&c| all[c as usize * per..(c as usize + 1) * per].iter().copied())
+                        .collect()
+                }
+            }
+        }
+    };
+    let velocity = match &body.velocity {
+        None => None,
+        Some(components) => Some(
+            VectorField::<D>::compile(components, false)
+                .map_err(|reason| scene.value_error(key("velocity"), reason))?,
+        ),
+    };
+    let before = seeds.position.len();
+    for (x, volume) in samples.iter().filter(|(x, _)| region.contains(x)) {
+        let v = match &velocity {
+            None => SVector::zeros(),
+            Some(field) => field
+                .eval(x, 0.0)
+                .map_err(|reason| scene.value_error(key("velocity"), reason))?,
+        };
+        seeds.position.push(*x);
+        seeds.volume.push(*volume);
+        seeds.mass.push(volume * density);
+        seeds.velocity.push(v);
+        seeds.material.push(material);
+    }
+    if seeds.position.len() == before {
+        return Err(scene.value_error(key("region"), "the region holds no particle"));
+    }
+    Ok(())
+}
+
+/// Builds the D-dimensional setup of `scene`.
+pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>> {
+    let spec = &scene.spec;
+    let (mesh, lattice_spacing, groups) = mesh::<D>(scene, split)?;
+    if spec.materials.is_empty() {
+        return Err(scene.value_error("materials", "at least one material is needed"));
+    }
+    if spec.materials.len() > usize::from(u16::MAX) {
+        return Err(scene.value_error("materials", "too many materials"));
+    }
+    let models = (0..spec.materials.len())
+        .map(|i| material(scene, i))
+        .collect::<Result<Vec<_>>>()?;
+    let material_names: Vec<String> = spec.materials.iter().map(|m| m.name.clone()).collect();
+    if spec.bodies.is_empty() {
+        return Err(scene.value_error("bodies", "at least one body is needed"));
+    }
+    let mut seeds = Seeds::default();
+    for (i, body) in spec.bodies.iter().enumerate() {
+        let material = material_names
+            .iter()
+            .position(|n| *n == body.material)
+            .ok_or_else(|| {
+                scene.value_error(
+                    format!("bodies[{i}].material"),
+                    format!("no material `{}` (defined: {})", body.material, material_names.join(", ")),
+                )
+            })?;
+        seed_body(scene, i, &mesh, &groups, material as u16, &mut seeds)?;
+    }
+    let mut boundaries = Vec::new();
+    for (i, b) in spec.boundaries.iter().enumerate() {
+        let target = match (&b.plane, &b.group) {
+            (Some(plane), None) => {
+                let normal: SVector<f64, D> = vector(scene, &format!("boundaries[{i}].plane.normal"), &plane.normal)?;
+                if normal.norm() == 0.0 {
+                    return Err(scene.value_error(format!("boundaries[{i}].plane.normal"), "must not be zero"));
+                }
+                BoundaryTarget::Plane {
+                    point: vector(scene, &format!("boundaries[{i}].plane.point"), &plane.point)?,
+                    normal: normal.normalize(),
+                }
+            }
+            (None, Some(name)) => {
+                let g = group(scene, &groups, &format!("boundaries[{i}].group"), name)?;
+                BoundaryTarget::Vertices(
+                    g.vertices
+                        .iter()
+                        .map(|&v| (v, mesh.topology().vertex_normal(v as usize)))
+                        .collect(),
+                )
+            }
+            _ => {
+                return Err(scene.value_error(format!("boundaries[{i}]"), "give exactly one of `plane` and `group`"));
+            }
+        };
+        boundaries.push((b.kind, target));
+    }
+    let gravity = match &spec.scene.gravity {
+        None => SVector::zeros(),
+        Some(g) => vector(scene, "scene.gravity", g)?,
+    };
+    let stress_update = match spec.time.stress_update.as_deref().unwrap_or("usl") {
+        "usl" => StressUpdate::Usl,
+        "musl" => StressUpdate::Musl,
+        other => return Err(scene.value_error("time.stress_update", format!("`{other}`: expected usl or musl"))),
+    };
+    let reference = match &spec.reference {
+        None => None,
+        Some(r) => {
+            let field = VectorField::<D>::compile(&r.velocity, true)
+                .map_err(|reason| scene.value_error("reference.velocity", reason))?;
+            let scale = match r.scale {
+                Some(s) if s.is_finite() && s > 0.0 => s,
+                Some(_) => return Err(scene.value_error("reference.scale", "must be positive")),
+                None => {
+                    let mut largest = 0.0f64;
+                    for x in &seeds.position {
+                        let v = field.eval(x, 0.0).map_err(|reason| scene.value_error("reference.velocity", reason))?;
+                        largest = largest.max(v.norm());
+                    }
+                    if largest == 0.0 {
+                        return Err(scene.value_error("reference.scale", "the reference velocity is zero at t = 0; give a scale"));
+                    }
+                    largest
+                }
+            };
+            Some((field, scale))
+        }
+    };
+    Ok(Setup {
+        mesh: Arc::new(mesh),
+        lattice_spacing,
+        groups,
+        seeds,
+        models,
+        material_names,
+        boundaries,
+        gravity,
+        stress_update,
+        reference,
+    })
+}
+
+/// Checks shared by every dimension before any work: end time, time step, output counts.
+pub fn check_header(scene: &Scene) -> Result<()> {
+    let spec = &scene.spec;
+    if !(spec.scene.end_time.is_finite() && spec.scene.end_time > 0.0) {
+        return Err(scene.value_error("scene.end_time", "must be finite and positive"));
+    }
+    match (spec.time.dt, spec.time.cfl) {
+        (Some(dt), None) if dt.is_finite() && dt > 0.0 => {}
+        (None, Some(cfl)) if cfl.is_finite() && cfl > 0.0 && cfl <= 1.0 => {}
+        (Some(_), None) => return Err(scene.value_error("time.dt", "must be finite and positive")),
+        (None, Some(_)) => return Err(scene.value_error("time.cfl", "must be in (0, 1]")),
+        _ => return Err(scene.value_error("time", "give exactly one of `dt` and `cfl`")),
+    }
+    if spec.output.frames < 2 {
+        return Err(scene.value_error("output.frames", "at least 2 (the first and the last state)"));
+    }
+    if spec.output.history_every == 0 {
+        return Err(scene.value_error("output.history_every", "must be at least 1"));
+    }
+    if !(0.0..=1.0).contains(&spec.transfer.alpha) {
+        return Err(scene.value_error("transfer.alpha", "must be in [0, 1]"));
+    }
+    if !(1..=3).contains(&spec.scene.dimension) {
+        return Err(scene.value_error("scene.dimension", "must be 1, 2 or 3"));
+    }
+    Ok(())
+}
+
+/// The error for a scene that is plastic in 1D.
+pub fn plastic_in_1d(scene: &Scene) -> CliError {
+    scene.value_error("materials", "plastic models need dimension 2 (plane strain) or 3")
+}

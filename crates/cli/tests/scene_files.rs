@@ -1,0 +1,159 @@
+//! Scene files: the built-in ones build the same particles and give the same results as
+//! the hand-written scenes of `umls-scenes`; bad files fail naming the key.
+
+use umls_cli::run::{RunOptions, run};
+use umls_cli::scene::Scene;
+use umls_cli::setup::build;
+use umls_cli::CliError;
+use umls_engine::Apic;
+use umls_kernels::{Umls1, Umls2};
+use umls_mesh::generate::Diagonal;
+use umls_scenes::colliding_disks::CollidingDisks;
+use umls_scenes::vibrating_bar::VibratingBar;
+
+fn options(name: &str, end_time: Option<f64>) -> RunOptions {
+    RunOptions {
+        kernel: None,
+        out: std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name),
+        end_time,
+        threads: Some(2),
+        progress: false,
+    }
+}
+
+fn split2(
+    l: &umls_mesh::generate::Lattice<2>,
+    d: Diagonal,
+) -> Result<umls_mesh::SimplexMesh<2>, umls_mesh::MeshError> {
+    l.triangles(d)
+}
+
+#[test]
+fn disks_file_builds_the_hand_written_scene() {
+    let scene = Scene::load("colliding-disks").unwrap();
+    let setup = build::<2>(&scene, split2).unwrap();
+    let reference = CollidingDisks::default();
+    let particles = reference.particles::<()>();
+    // The same lattice points, from different origins: equal to round-off, same order.
+    assert_eq!(setup.seeds.position.len(), particles.position.len());
+    let offset = setup
+        .seeds
+        .position
+        .iter()
+        .zip(&particles.position)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(offset < 1e-15, "{offset}");
+    assert_eq!(setup.seeds.velocity, particles.velocity);
+    assert_eq!(setup.seeds.mass, particles.mass);
+    assert_eq!(setup.mesh.vertices(), reference.mesh().unwrap().vertices());
+    assert_eq!(setup.mesh.connectivity(), reference.mesh().unwrap().connectivity());
+}
+
+#[test]
+fn disks_file_runs_like_the_hand_written_scene() {
+    let scene = Scene::load("colliding-disks").unwrap();
+    let report = run(&scene, &options("disks-file", Some(0.05))).unwrap();
+    let reference = CollidingDisks::default();
+    let mesh = reference.shared_mesh().unwrap();
+    let mut sim = reference
+        .simulation(Umls2::new(mesh), umls_engine::Flip { alpha: 0.99 })
+        .unwrap();
+    for _ in 0..50 {
+        sim.step().unwrap();
+    }
+    let d = sim.diagnostics().unwrap();
+    let s = &report.summary;
+    assert_eq!(s["steps"], 50);
+    let final_energy = s["metrics"]["final_energy"].as_f64().unwrap();
+    assert!(
+        (final_energy - d.total_energy()).abs() < 1e-12 * d.total_energy(),
+        "{final_energy} vs {}",
+        d.total_energy()
+    );
+}
+
+#[test]
+fn bar_file_matches_the_hand_written_scene_error() {
+    let scene = Scene::load("vibrating-bar").unwrap();
+    let report = run(&scene, &options("bar-file", None)).unwrap();
+    let file_rmse = report.summary["metrics"]["velocity_rmse"].as_f64().unwrap();
+    let bar = VibratingBar {
+        cells: 50,
+        ..VibratingBar::default()
+    };
+    let (steps, _) = bar.steps_and_dt();
+    assert_eq!(report.summary["steps"], steps);
+    let mesh = std::sync::Arc::new(bar.mesh().unwrap());
+    let expected = bar.run(Umls1::new(mesh), Apic).unwrap().velocity_rmse;
+    assert!(
+        (file_rmse - expected).abs() < 1e-9 * expected,
+        "{file_rmse} vs {expected}"
+    );
+    // Second-order UMLS on 50 cells: the error is small.
+    assert!(file_rmse < 2e-3, "{file_rmse}");
+}
+
+fn with(text: &str, find: &str, replace: &str) -> Scene {
+    let builtin = umls_cli::builtin::BUILTIN
+        .iter()
+        .find(|b| b.name == text)
+        .unwrap();
+    assert!(builtin.toml.contains(find), "{find}");
+    Scene::parse(&builtin.toml.replacen(find, replace, 1), "edited.toml", None).unwrap()
+}
+
+fn message(scene_name: &str, find: &str, replace: &str) -> String {
+    let builtin = umls_cli::builtin::BUILTIN
+        .iter()
+        .find(|b| b.name == scene_name)
+        .unwrap();
+    let text = builtin.toml.replacen(find, replace, 1);
+    match Scene::parse(&text, "edited.toml", None) {
+        Err(e) => e.to_string(),
+        Ok(scene) => run(&scene, &options("bad", Some(0.01)))
+            .map(|_| String::from("accepted"))
+            .unwrap_or_else(|e| e.to_string()),
+    }
+}
+
+#[test]
+fn unknown_keys_are_named() {
+    let m = message("colliding-disks", "young = 1000.0", "youngs = 1000.0");
+    assert!(m.contains("unknown field `youngs`"), "{m}");
+    assert!(m.starts_with("edited.toml"), "{m}");
+    let m = message("colliding-disks", "[time]", "[time]\ndtt = 1");
+    assert!(m.contains("unknown field `dtt`"), "{m}");
+}
+
+#[test]
+fn bad_values_name_their_key() {
+    for (scene, find, replace, key) in [
+        ("colliding-disks", "material = \"elastic\"", "material = \"steel\"", "`bodies[0].material`"),
+        ("colliding-disks", "dt = 1e-3", "dt = 1e-3\ncfl = 0.5", "`time`"),
+        ("colliding-disks", "velocity = [0.1, 0.1]", "velocity = [0.1]", "`bodies[0].velocity`"),
+        ("colliding-disks", "velocity = [0.1, 0.1]", "velocity = [\"q * 2\", 0]", "`bodies[0].velocity`"),
+        ("colliding-disks", "young = 1000.0\n", "", "`materials[0].young`"),
+        ("colliding-disks", "model = \"linear-elastic\"", "model = \"jelly\"", "`materials[0].model`"),
+        ("colliding-disks", "poisson = 0.3", "poisson = 0.5", "`materials[0].young`"),
+        ("colliding-disks", "jitter = 0.2", "jitter = 0.6", "`mesh.lattice`"),
+        ("colliding-disks", "alpha = 0.99", "alpha = 1.5", "`transfer.alpha`"),
+        ("colliding-disks", "radius = 0.2 } }\nseeding", "radius = 0.0 } }\nseeding", "`bodies[0].region`"),
+        ("vibrating-bar", "model = \"linear-elastic\"", "model = \"von-mises\"\nyield_stress = 1.0", "`materials`"),
+        ("vibrating-bar", "scale = 0.1", "scale = -1.0", "`reference.scale`"),
+        ("cantilever", "group = \"wall\"", "group = \"floor\"", "`boundaries[0].group`"),
+    ] {
+        let m = message(scene, find, replace);
+        assert!(m.contains(key), "{scene}: `{replace}` gave: {m}");
+    }
+}
+
+#[test]
+fn group_conditions_need_mesh_nodes() {
+    let scene = with("cantilever", "kind = \"umls\"", "kind = \"bspline2\"");
+    let err = run(&scene, &options("cantilever-bspline", Some(1e-3))).unwrap_err();
+    assert!(
+        matches!(&err, CliError::SceneValue { key, .. } if key == "boundaries[0].group"),
+        "{err}"
+    );
+}

@@ -1,0 +1,21 @@
+"""Regenerates the Gmsh meshes of the built-in scenes (needs `pip install gmsh`)."""
+import gmsh
+
+gmsh.initialize()
+gmsh.option.setNumber("General.Terminal", 0)
+
+# cantilever.msh: the room around a cantilever, [0, 2.4] x [-0.6, 0.4], unstructured
+# triangles of size 0.05; physical groups "wall" (the edge x = 0) and "room".
+gmsh.model.add("cantilever")
+r = gmsh.model.occ.addRectangle(0, -0.6, 0, 2.4, 1.0)
+gmsh.model.occ.synchronize()
+gmsh.model.mesh.setSize(gmsh.model.getEntities(0), 0.05)
+wall = [c for _, c in gmsh.model.getBoundary([(2, r)], oriented=False)
+        if abs(gmsh.model.occ.getCenterOfMass(1, c)[0]) < 1e-12]
+gmsh.model.addPhysicalGroup(1, wall, name="wall")
+gmsh.model.addPhysicalGroup(2, [r], name="room")
+gmsh.model.mesh.generate(2)
+gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+gmsh.option.setNumber("Mesh.Binary", 0)
+gmsh.write("cantilever.msh")
+gmsh.finalize()
