@@ -15,7 +15,8 @@ const VARIABLES: [&str; 4] = ["x", "y", "z", "t"];
 enum Compiled {
     Constant(f64),
     Expression {
-        expr: FlatEx<f64>,
+        /// Boxed: a flattened expression is large, constants are common.
+        expr: Box<FlatEx<f64>>,
         /// For each of the expression's variables (exmex orders them alphabetically),
         /// its slot in [x, y, z, t].
         slots: Vec<usize>,
@@ -62,7 +63,10 @@ impl<const D: usize> VectorField<D> {
                                 })
                         })
                         .collect::<Result<Vec<_>, String>>()?;
-                    Ok(Compiled::Expression { expr, slots })
+                    Ok(Compiled::Expression {
+                        expr: Box::new(expr),
+                        slots,
+                    })
                 }
             })
             .collect::<Result<Vec<_>, String>>()?;

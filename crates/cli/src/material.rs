@@ -160,7 +160,9 @@ impl<const D: usize, P: PlasticPart<D>> Constitutive<D> for MaterialTable<P> {
         state: &Self::State,
     ) -> Result<SMatrix<f64, D, D>, ConstitutiveError> {
         match self.get(state.material)? {
-            Model::Elastic(m) => elastic_dispatch!(m, m => Constitutive::<D>::kirchhoff_stress(m, f, &())),
+            Model::Elastic(m) => {
+                elastic_dispatch!(m, m => Constitutive::<D>::kirchhoff_stress(m, f, &()))
+            }
             Model::Plastic(p) => p.model().kirchhoff_stress(f, &state.plastic),
         }
     }
@@ -171,7 +173,9 @@ impl<const D: usize, P: PlasticPart<D>> Constitutive<D> for MaterialTable<P> {
         state: &Self::State,
     ) -> Result<f64, ConstitutiveError> {
         match self.get(state.material)? {
-            Model::Elastic(m) => elastic_dispatch!(m, m => Constitutive::<D>::energy_density(m, f, &())),
+            Model::Elastic(m) => {
+                elastic_dispatch!(m, m => Constitutive::<D>::energy_density(m, f, &()))
+            }
             Model::Plastic(p) => p.model().energy_density(f, &state.plastic),
         }
     }
@@ -181,7 +185,9 @@ impl<const D: usize, P: PlasticPart<D>> Constitutive<D> for MaterialTable<P> {
         self.models
             .iter()
             .map(|m| match m {
-                Model::Elastic(m) => elastic_dispatch!(m, m => Constitutive::<D>::p_wave_modulus(m)),
+                Model::Elastic(m) => {
+                    elastic_dispatch!(m, m => Constitutive::<D>::p_wave_modulus(m))
+                }
                 Model::Plastic(p) => p.model().p_wave_modulus(),
             })
             .fold(0.0, f64::max)

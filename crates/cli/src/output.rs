@@ -69,8 +69,16 @@ impl OutputDir {
             .collect();
         grid.add_point_vectors("displacement", &displacement)?;
         let kirchhoff = sim.stresses()?;
-        let jacobian: Vec<f64> = p.deformation.iter().map(umls_constitutive::determinant).collect();
-        let cauchy: Vec<_> = kirchhoff.iter().zip(&jacobian).map(|(t, j)| t / *j).collect();
+        let jacobian: Vec<f64> = p
+            .deformation
+            .iter()
+            .map(umls_constitutive::determinant)
+            .collect();
+        let cauchy: Vec<_> = kirchhoff
+            .iter()
+            .zip(&jacobian)
+            .map(|(t, j)| t / *j)
+            .collect();
         grid.add_point_tensors("cauchy_stress", &cauchy)?;
         grid.add_point_field(
             "mean_stress",
@@ -91,7 +99,12 @@ impl OutputDir {
                 sim.material.state_scalars(s, &mut values);
             }
             for (k, name) in names.iter().enumerate() {
-                let column = values.iter().skip(k).step_by(names.len()).copied().collect();
+                let column = values
+                    .iter()
+                    .skip(k)
+                    .step_by(names.len())
+                    .copied()
+                    .collect();
                 grid.add_point_field(name, 1, column)?;
             }
         }

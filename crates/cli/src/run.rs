@@ -94,7 +94,13 @@ impl Dimension<2> for D2 {
         Umls2::new(mesh)
     }
     fn run_plastic<K: Kernel<2>>(ctx: &Context<'_, 2>, kernel: K) -> Result<RunReport> {
-        with_material(ctx, kernel, MaterialTable::<PlasticModel> { models: ctx.setup.models.clone() })
+        with_material(
+            ctx,
+            kernel,
+            MaterialTable::<PlasticModel> {
+                models: ctx.setup.models.clone(),
+            },
+        )
     }
 }
 
@@ -105,7 +111,13 @@ impl Dimension<3> for D3 {
         Umls3::new(mesh)
     }
     fn run_plastic<K: Kernel<3>>(ctx: &Context<'_, 3>, kernel: K) -> Result<RunReport> {
-        with_material(ctx, kernel, MaterialTable::<PlasticModel> { models: ctx.setup.models.clone() })
+        with_material(
+            ctx,
+            kernel,
+            MaterialTable::<PlasticModel> {
+                models: ctx.setup.models.clone(),
+            },
+        )
     }
 }
 
@@ -144,12 +156,20 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<RunReport> {
     })
 }
 
-fn run_dim<const D: usize, X: Dimension<D>>(scene: &Scene, options: &RunOptions) -> Result<RunReport> {
+fn run_dim<const D: usize, X: Dimension<D>>(
+    scene: &Scene,
+    options: &RunOptions,
+) -> Result<RunReport> {
     let setup = setup::build::<D>(scene, X::SPLIT)?;
     let encoding = match scene.spec.output.encoding.as_deref().unwrap_or("binary") {
         "binary" => Encoding::Binary,
         "ascii" => Encoding::Ascii,
-        other => return Err(scene.value_error("output.encoding", format!("`{other}`: expected binary or ascii"))),
+        other => {
+            return Err(scene.value_error(
+                "output.encoding",
+                format!("`{other}`: expected binary or ascii"),
+            ));
+        }
     };
     let ctx = Context {
         scene,
@@ -163,7 +183,9 @@ fn run_dim<const D: usize, X: Dimension<D>>(scene: &Scene, options: &RunOptions)
     match ctx.kernel {
         KernelKind::Umls => with_kernel::<D, X, _>(&ctx, X::umls(mesh)),
         KernelKind::LinearFe => with_kernel::<D, X, _>(&ctx, LinearFeKernel::new(mesh)),
-        KernelKind::Bspline2 => with_kernel::<D, X, _>(&ctx, bspline(&ctx, BSplineOrder::Quadratic)?),
+        KernelKind::Bspline2 => {
+            with_kernel::<D, X, _>(&ctx, bspline(&ctx, BSplineOrder::Quadratic)?)
+        }
         KernelKind::Bspline3 => with_kernel::<D, X, _>(&ctx, bspline(&ctx, BSplineOrder::Cubic)?),
     }
 }
@@ -181,16 +203,25 @@ fn bspline<const D: usize>(ctx: &Context<'_, D>, order: BSplineOrder) -> Result<
         .or(ctx.setup.lattice_spacing)
         .unwrap_or_else(|| mesh.max_edge_length() / (D as f64).sqrt());
     if !(h.is_finite() && h > 0.0) {
-        return Err(ctx.scene.value_error("kernel.grid_spacing", "must be positive"));
+        return Err(ctx
+            .scene
+            .value_error("kernel.grid_spacing", "must be positive"));
     }
     let (lower, upper) = mesh.bounding_box();
     let origin = lower.add_scalar(-(MARGIN as f64) * h);
-    let cells: [usize; D] = std::array::from_fn(|k| ((upper[k] - lower[k]) / h - 1e-9).ceil().max(1.0) as usize + 2 * MARGIN);
-    BSplineKernel::new(origin, h, cells, order)
-        .ok_or_else(|| ctx.scene.value_error("kernel.grid_spacing", "too coarse for one B-spline stencil"))
+    let cells: [usize; D] = std::array::from_fn(|k| {
+        ((upper[k] - lower[k]) / h - 1e-9).ceil().max(1.0) as usize + 2 * MARGIN
+    });
+    BSplineKernel::new(origin, h, cells, order).ok_or_else(|| {
+        ctx.scene
+            .value_error("kernel.grid_spacing", "too coarse for one B-spline stencil")
+    })
 }
 
-fn with_kernel<const D: usize, X: Dimension<D>, K: Kernel<D>>(ctx: &Context<'_, D>, kernel: K) -> Result<RunReport> {
+fn with_kernel<const D: usize, X: Dimension<D>, K: Kernel<D>>(
+    ctx: &Context<'_, D>,
+    kernel: K,
+) -> Result<RunReport> {
     if ctx.setup.has_plasticity() {
         return X::run_plastic(ctx, kernel);
     }
@@ -230,11 +261,20 @@ fn transfer_name(spec: &crate::schema::TransferSpec) -> String {
 }
 
 /// Energy with the gravitational potential −Σ m g·x, so that gravity scenes conserve it too.
-fn total_energy<const D: usize>(d: &Diagnostics<D>, gravity: &SVector<f64, D>, positions: &[SVector<f64, D>], mass: &[f64]) -> (f64, f64) {
+fn total_energy<const D: usize>(
+    d: &Diagnostics<D>,
+    gravity: &SVector<f64, D>,
+    positions: &[SVector<f64, D>],
+    mass: &[f64],
+) -> (f64, f64) {
     let potential: f64 = if gravity.norm() == 0.0 {
         0.0
     } else {
-        -positions.iter().zip(mass).map(|(x, m)| m * gravity.dot(x)).sum::<f64>()
+        -positions
+            .iter()
+            .zip(mass)
+            .map(|(x, m)| m * gravity.dot(x))
+            .sum::<f64>()
     };
     (potential, d.total_energy() + potential)
 }
@@ -276,13 +316,20 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         match target {
             BoundaryTarget::Plane { point, normal } => {
                 let tolerance = 1e-6 * sim.kernel.spacing();
-                let nodes = umls_engine::Boundary::nodes_on_plane(&sim.kernel, point, normal, tolerance);
+                let nodes =
+                    umls_engine::Boundary::nodes_on_plane(&sim.kernel, point, normal, tolerance);
                 if nodes.is_empty() {
-                    return Err(scene.value_error(format!("boundaries[{i}].plane"), format!("no {} node lies on the plane", ctx.kernel.name())));
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].plane"),
+                        format!("no {} node lies on the plane", ctx.kernel.name()),
+                    ));
                 }
                 match kind {
                     BoundaryKind::Fixed => sim.boundary.fixed.extend(nodes),
-                    BoundaryKind::Slip => sim.boundary.slip.extend(nodes.into_iter().map(|n| (n, *normal))),
+                    BoundaryKind::Slip => sim
+                        .boundary
+                        .slip
+                        .extend(nodes.into_iter().map(|n| (n, *normal))),
                 }
             }
             BoundaryTarget::Vertices(vertices) => {
@@ -293,7 +340,9 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
                     ));
                 }
                 match kind {
-                    BoundaryKind::Fixed => sim.boundary.fixed.extend(vertices.iter().map(|(v, _)| *v)),
+                    BoundaryKind::Fixed => {
+                        sim.boundary.fixed.extend(vertices.iter().map(|(v, _)| *v))
+                    }
                     BoundaryKind::Slip => sim.boundary.slip.extend(vertices.iter().copied()),
                 }
             }
@@ -318,10 +367,25 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     let frames = spec.output.frames;
     let frame_time = |k: usize| ctx.end_time * k as f64 / (frames - 1) as f64;
     let mut next_frame = 1;
-    let record = |sim: &Simulation<D, K, MaterialTable<P>, T>, history: &mut HistoryWriter, error: Option<f64>| -> Result<(f64, Diagnostics<D>)> {
+    let record = |sim: &Simulation<D, K, MaterialTable<P>, T>,
+                  history: &mut HistoryWriter,
+                  error: Option<f64>|
+     -> Result<(f64, Diagnostics<D>)> {
         let d = sim.diagnostics()?;
-        let (potential, total) = total_energy(&d, &setup.gravity, &sim.particles.position, &sim.particles.mass);
-        let mut row = vec![d.step as f64, d.time, d.kinetic, d.elastic, potential, total];
+        let (potential, total) = total_energy(
+            &d,
+            &setup.gravity,
+            &sim.particles.position,
+            &sim.particles.mass,
+        );
+        let mut row = vec![
+            d.step as f64,
+            d.time,
+            d.kinetic,
+            d.elastic,
+            potential,
+            total,
+        ];
         row.extend(d.momentum.iter());
         row.extend([d.mass, d.max_speed, d.courant]);
         row.extend(error);
@@ -390,13 +454,23 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     }
     let taken = sim.step_count();
     let mut metrics = serde_json::Map::new();
-    let energy_error = if energy_scale > 0.0 { energy_change / energy_scale } else { 0.0 };
+    let energy_error = if energy_scale > 0.0 {
+        energy_change / energy_scale
+    } else {
+        0.0
+    };
     metrics.insert("energy_error".into(), json!(energy_error));
     metrics.insert("initial_energy".into(), json!(e0));
     metrics.insert("final_energy".into(), json!(last_total));
-    metrics.insert("momentum_change".into(), json!((last.momentum - d0.momentum).norm()));
+    metrics.insert(
+        "momentum_change".into(),
+        json!((last.momentum - d0.momentum).norm()),
+    );
     if setup.reference.is_some() && taken > 0 {
-        metrics.insert("velocity_rmse".into(), json!((error_sum / taken as f64).sqrt()));
+        metrics.insert(
+            "velocity_rmse".into(),
+            json!((error_sum / taken as f64).sqrt()),
+        );
         metrics.insert("velocity_error_max".into(), json!(error_max));
     }
     let summary = json!({

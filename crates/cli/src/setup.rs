@@ -84,7 +84,10 @@ fn vector<const D: usize>(scene: &Scene, key: &str, values: &[f64]) -> Result<SV
     if values.len() != D {
         return Err(scene.value_error(
             key,
-            format!("{} components given, the scene is {D}-dimensional", values.len()),
+            format!(
+                "{} components given, the scene is {D}-dimensional",
+                values.len()
+            ),
         ));
     }
     if values.iter().any(|v| !v.is_finite()) {
@@ -95,7 +98,8 @@ fn vector<const D: usize>(scene: &Scene, key: &str, values: &[f64]) -> Result<SV
 
 /// Splits a lattice into simplices (segments, triangles with the given diagonals, or
 /// tetrahedra); the generator's split exists per dimension, so the caller supplies it.
-pub type Split<const D: usize> = fn(&Lattice<D>, Diagonal) -> std::result::Result<SimplexMesh<D>, umls_mesh::MeshError>;
+pub type Split<const D: usize> =
+    fn(&Lattice<D>, Diagonal) -> std::result::Result<SimplexMesh<D>, umls_mesh::MeshError>;
 
 fn mesh<const D: usize>(
     scene: &Scene,
@@ -129,7 +133,8 @@ fn mesh<const D: usize>(
             let diagonal = match l.diagonal.as_deref() {
                 None | Some("alternating") => Diagonal::Alternating,
                 Some(_) if D != 2 => {
-                    return Err(scene.value_error("mesh.lattice.diagonal", "only 2D lattices have diagonals"));
+                    return Err(scene
+                        .value_error("mesh.lattice.diagonal", "only 2D lattices have diagonals"));
                 }
                 Some("right") => Diagonal::Right,
                 Some("left") => Diagonal::Left,
@@ -153,9 +158,13 @@ fn material(scene: &Scene, index: usize) -> Result<Model<PlasticModel>> {
     let m = &scene.spec.materials[index];
     let key = |field: &str| format!("materials[{index}].{field}");
     let need = |value: Option<f64>, field: &str| {
-        value.ok_or_else(|| scene.value_error(key(field), format!("required by model `{}`", m.model)))
+        value.ok_or_else(|| {
+            scene.value_error(key(field), format!("required by model `{}`", m.model))
+        })
     };
-    let bad = |field: &str, e: umls_constitutive::ConstitutiveError| scene.value_error(key(field), e.to_string());
+    let bad = |field: &str, e: umls_constitutive::ConstitutiveError| {
+        scene.value_error(key(field), e.to_string())
+    };
     if !(m.density.is_finite() && m.density > 0.0) {
         return Err(scene.value_error(key("density"), "must be finite and positive"));
     }
@@ -165,12 +174,20 @@ fn material(scene: &Scene, index: usize) -> Result<Model<PlasticModel>> {
     };
     let degrees = |v: f64| v.to_radians();
     Ok(match m.model.as_str() {
-        "linear-elastic" => Model::Elastic(ElasticModel::Linear(LinearElastic { parameters: elastic()? })),
-        "neo-hookean" => Model::Elastic(ElasticModel::NeoHookean(NeoHookean { parameters: elastic()? })),
-        "st-venant-kirchhoff" => Model::Elastic(ElasticModel::StVenantKirchhoff(StVenantKirchhoff {
+        "linear-elastic" => Model::Elastic(ElasticModel::Linear(LinearElastic {
             parameters: elastic()?,
         })),
-        "fixed-corotated" => Model::Elastic(ElasticModel::Corotated(FixedCorotated { parameters: elastic()? })),
+        "neo-hookean" => Model::Elastic(ElasticModel::NeoHookean(NeoHookean {
+            parameters: elastic()?,
+        })),
+        "st-venant-kirchhoff" => {
+            Model::Elastic(ElasticModel::StVenantKirchhoff(StVenantKirchhoff {
+                parameters: elastic()?,
+            }))
+        }
+        "fixed-corotated" => Model::Elastic(ElasticModel::Corotated(FixedCorotated {
+            parameters: elastic()?,
+        })),
         "fluid" => Model::Elastic(ElasticModel::Fluid(
             WeaklyCompressibleFluid::new(need(m.bulk, "bulk")?, m.gamma.unwrap_or(7.0))
                 .map_err(|e| bad("bulk", e))?,
@@ -183,12 +200,21 @@ fn material(scene: &Scene, index: usize) -> Result<Model<PlasticModel>> {
                 ConeFit::PlaneStrain,
             )
             .map_err(|e| bad("friction_angle", e))?;
-            Model::Plastic(PlasticModel::DruckerPrager(ElastoPlastic::new(elastic()?, criterion)))
+            Model::Plastic(PlasticModel::DruckerPrager(ElastoPlastic::new(
+                elastic()?,
+                criterion,
+            )))
         }
         "von-mises" => {
-            let criterion = VonMises::new(need(m.yield_stress, "yield_stress")?, m.hardening.unwrap_or(0.0))
-                .map_err(|e| bad("yield_stress", e))?;
-            Model::Plastic(PlasticModel::VonMises(ElastoPlastic::new(elastic()?, criterion)))
+            let criterion = VonMises::new(
+                need(m.yield_stress, "yield_stress")?,
+                m.hardening.unwrap_or(0.0),
+            )
+            .map_err(|e| bad("yield_stress", e))?;
+            Model::Plastic(PlasticModel::VonMises(ElastoPlastic::new(
+                elastic()?,
+                criterion,
+            )))
         }
         other => {
             return Err(scene.value_error(
@@ -201,7 +227,12 @@ fn material(scene: &Scene, index: usize) -> Result<Model<PlasticModel>> {
     })
 }
 
-fn group<'a>(scene: &Scene, groups: &'a [PhysicalGroup], key: &str, name: &str) -> Result<&'a PhysicalGroup> {
+fn group<'a>(
+    scene: &Scene,
+    groups: &'a [PhysicalGroup],
+    key: &str,
+    name: &str,
+) -> Result<&'a PhysicalGroup> {
     groups.iter().find(|g| g.name == name).ok_or_else(|| {
         let known: Vec<&str> = groups.iter().map(|g| g.name.as_str()).collect();
         scene.value_error(
@@ -209,7 +240,10 @@ fn group<'a>(scene: &Scene, groups: &'a [PhysicalGroup], key: &str, name: &str) 
             if known.is_empty() {
                 format!("no physical group `{name}`: the mesh has none (only Gmsh files do)")
             } else {
-                format!("no physical group `{name}` (the mesh has: {})", known.join(", "))
+                format!(
+                    "no physical group `{name}` (the mesh has: {})",
+                    known.join(", ")
+                )
             },
         )
     })
@@ -230,7 +264,10 @@ fn seed_body<const D: usize>(
     let region: Region<D> = match &body.region {
         None | Some(RegionSpec::Everywhere(true)) => Region::Everywhere,
         Some(RegionSpec::Everywhere(false)) => {
-            return Err(scene.value_error(key("region.everywhere"), "`false` selects nothing; omit the region instead"));
+            return Err(scene.value_error(
+                key("region.everywhere"),
+                "`false` selects nothing; omit the region instead",
+            ));
         }
         Some(RegionSpec::Box { lower, upper }) => Region::Box {
             lower: vector(scene, &key("region.box.lower"), lower)?,
@@ -247,7 +284,13 @@ fn seed_body<const D: usize>(
         Some(RegionSpec::Group(name)) => {
             let g = group(scene, groups, &key("region.group"), name)?;
             if g.dimension != D {
-                return Err(scene.value_error(key("region.group"), format!("`{name}` is a {}D group; a body needs {D}D cells", g.dimension)));
+                return Err(scene.value_error(
+                    key("region.group"),
+                    format!(
+                        "`{name}` is a {}D group; a body needs {D}D cells",
+                        g.dimension
+                    ),
+                ));
             }
             cells = Some(&g.cells);
             Region::Everywhere
@@ -256,7 +299,10 @@ fn seed_body<const D: usize>(
     let samples: Vec<(SVector<f64, D>, f64)> = match &body.seeding {
         SeedingSpec::Lattice(h) => {
             if cells.is_some() {
-                return Err(scene.value_error(key("seeding"), "a group region needs mesh seeding (`centroid` or `gauss2`)"));
+                return Err(scene.value_error(
+                    key("seeding"),
+                    "a group region needs mesh seeding (`centroid` or `gauss2`)",
+                ));
             }
             if !(h.is_finite() && *h > 0.0) {
                 return Err(scene.value_error(key("seeding.lattice"), "spacing must be positive"));
@@ -268,7 +314,12 @@ fn seed_body<const D: usize>(
             let rule = match rule.as_str() {
                 "centroid" => SampleRule::Centroid,
                 "gauss2" => SampleRule::Gauss2,
-                other => return Err(scene.value_error(key("seeding.mesh"), format!("`{other}`: expected centroid or gauss2"))),
+                other => {
+                    return Err(scene.value_error(
+                        key("seeding.mesh"),
+                        format!("`{other}`: expected centroid or gauss2"),
+                    ));
+                }
             };
             let all = mesh.sample_points(rule);
             match cells {
@@ -277,7 +328,11 @@ fn seed_body<const D: usize>(
                     let per = rule.count(D);
                     cells
                         .iter()
-                        .flat_map(|&c| all[c as usize * per..(c as usize + 1) * per].iter().copied())
+                        .flat_map(|&c| {
+                            all[c as usize * per..(c as usize + 1) * per]
+                                .iter()
+                                .copied()
+                        })
                         .collect()
                 }
             }
@@ -335,7 +390,11 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
             .ok_or_else(|| {
                 scene.value_error(
                     format!("bodies[{i}].material"),
-                    format!("no material `{}` (defined: {})", body.material, material_names.join(", ")),
+                    format!(
+                        "no material `{}` (defined: {})",
+                        body.material,
+                        material_names.join(", ")
+                    ),
                 )
             })?;
         seed_body(scene, i, &mesh, &groups, material as u16, &mut seeds)?;
@@ -344,9 +403,14 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
     for (i, b) in spec.boundaries.iter().enumerate() {
         let target = match (&b.plane, &b.group) {
             (Some(plane), None) => {
-                let normal: SVector<f64, D> = vector(scene, &format!("boundaries[{i}].plane.normal"), &plane.normal)?;
+                let normal: SVector<f64, D> = vector(
+                    scene,
+                    &format!("boundaries[{i}].plane.normal"),
+                    &plane.normal,
+                )?;
                 if normal.norm() == 0.0 {
-                    return Err(scene.value_error(format!("boundaries[{i}].plane.normal"), "must not be zero"));
+                    return Err(scene
+                        .value_error(format!("boundaries[{i}].plane.normal"), "must not be zero"));
                 }
                 BoundaryTarget::Plane {
                     point: vector(scene, &format!("boundaries[{i}].plane.point"), &plane.point)?,
@@ -363,7 +427,10 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
                 )
             }
             _ => {
-                return Err(scene.value_error(format!("boundaries[{i}]"), "give exactly one of `plane` and `group`"));
+                return Err(scene.value_error(
+                    format!("boundaries[{i}]"),
+                    "give exactly one of `plane` and `group`",
+                ));
             }
         };
         boundaries.push((b.kind, target));
@@ -375,7 +442,12 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
     let stress_update = match spec.time.stress_update.as_deref().unwrap_or("usl") {
         "usl" => StressUpdate::Usl,
         "musl" => StressUpdate::Musl,
-        other => return Err(scene.value_error("time.stress_update", format!("`{other}`: expected usl or musl"))),
+        other => {
+            return Err(scene.value_error(
+                "time.stress_update",
+                format!("`{other}`: expected usl or musl"),
+            ));
+        }
     };
     let reference = match &spec.reference {
         None => None,
@@ -388,11 +460,16 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
                 None => {
                     let mut largest = 0.0f64;
                     for x in &seeds.position {
-                        let v = field.eval(x, 0.0).map_err(|reason| scene.value_error("reference.velocity", reason))?;
+                        let v = field
+                            .eval(x, 0.0)
+                            .map_err(|reason| scene.value_error("reference.velocity", reason))?;
                         largest = largest.max(v.norm());
                     }
                     if largest == 0.0 {
-                        return Err(scene.value_error("reference.scale", "the reference velocity is zero at t = 0; give a scale"));
+                        return Err(scene.value_error(
+                            "reference.scale",
+                            "the reference velocity is zero at t = 0; give a scale",
+                        ));
                     }
                     largest
                 }
@@ -444,5 +521,8 @@ pub fn check_header(scene: &Scene) -> Result<()> {
 
 /// The error for a scene that is plastic in 1D.
 pub fn plastic_in_1d(scene: &Scene) -> CliError {
-    scene.value_error("materials", "plastic models need dimension 2 (plane strain) or 3")
+    scene.value_error(
+        "materials",
+        "plastic models need dimension 2 (plane strain) or 3",
+    )
 }

@@ -1,10 +1,10 @@
 //! Scene files: the built-in ones build the same particles and give the same results as
 //! the hand-written scenes of `umls-scenes`; bad files fail naming the key.
 
+use umls_cli::CliError;
 use umls_cli::run::{RunOptions, run};
 use umls_cli::scene::Scene;
 use umls_cli::setup::build;
-use umls_cli::CliError;
 use umls_engine::Apic;
 use umls_kernels::{Umls1, Umls2};
 use umls_mesh::generate::Diagonal;
@@ -47,7 +47,10 @@ fn disks_file_builds_the_hand_written_scene() {
     assert_eq!(setup.seeds.velocity, particles.velocity);
     assert_eq!(setup.seeds.mass, particles.mass);
     assert_eq!(setup.mesh.vertices(), reference.mesh().unwrap().vertices());
-    assert_eq!(setup.mesh.connectivity(), reference.mesh().unwrap().connectivity());
+    assert_eq!(
+        setup.mesh.connectivity(),
+        reference.mesh().unwrap().connectivity()
+    );
 }
 
 #[test]
@@ -100,7 +103,12 @@ fn with(text: &str, find: &str, replace: &str) -> Scene {
         .find(|b| b.name == text)
         .unwrap();
     assert!(builtin.toml.contains(find), "{find}");
-    Scene::parse(&builtin.toml.replacen(find, replace, 1), "edited.toml", None).unwrap()
+    Scene::parse(
+        &builtin.toml.replacen(find, replace, 1),
+        "edited.toml",
+        None,
+    )
+    .unwrap()
 }
 
 fn message(scene_name: &str, find: &str, replace: &str) -> String {
@@ -129,19 +137,84 @@ fn unknown_keys_are_named() {
 #[test]
 fn bad_values_name_their_key() {
     for (scene, find, replace, key) in [
-        ("colliding-disks", "material = \"elastic\"", "material = \"steel\"", "`bodies[0].material`"),
-        ("colliding-disks", "dt = 1e-3", "dt = 1e-3\ncfl = 0.5", "`time`"),
-        ("colliding-disks", "velocity = [0.1, 0.1]", "velocity = [0.1]", "`bodies[0].velocity`"),
-        ("colliding-disks", "velocity = [0.1, 0.1]", "velocity = [\"q * 2\", 0]", "`bodies[0].velocity`"),
-        ("colliding-disks", "young = 1000.0\n", "", "`materials[0].young`"),
-        ("colliding-disks", "model = \"linear-elastic\"", "model = \"jelly\"", "`materials[0].model`"),
-        ("colliding-disks", "poisson = 0.3", "poisson = 0.5", "`materials[0].young`"),
-        ("colliding-disks", "jitter = 0.2", "jitter = 0.6", "`mesh.lattice`"),
-        ("colliding-disks", "alpha = 0.99", "alpha = 1.5", "`transfer.alpha`"),
-        ("colliding-disks", "radius = 0.2 } }\nseeding", "radius = 0.0 } }\nseeding", "`bodies[0].region`"),
-        ("vibrating-bar", "model = \"linear-elastic\"", "model = \"von-mises\"\nyield_stress = 1.0", "`materials`"),
-        ("vibrating-bar", "scale = 0.1", "scale = -1.0", "`reference.scale`"),
-        ("cantilever", "group = \"wall\"", "group = \"floor\"", "`boundaries[0].group`"),
+        (
+            "colliding-disks",
+            "material = \"elastic\"",
+            "material = \"steel\"",
+            "`bodies[0].material`",
+        ),
+        (
+            "colliding-disks",
+            "dt = 1e-3",
+            "dt = 1e-3\ncfl = 0.5",
+            "`time`",
+        ),
+        (
+            "colliding-disks",
+            "velocity = [0.1, 0.1]",
+            "velocity = [0.1]",
+            "`bodies[0].velocity`",
+        ),
+        (
+            "colliding-disks",
+            "velocity = [0.1, 0.1]",
+            "velocity = [\"q * 2\", 0]",
+            "`bodies[0].velocity`",
+        ),
+        (
+            "colliding-disks",
+            "young = 1000.0\n",
+            "",
+            "`materials[0].young`",
+        ),
+        (
+            "colliding-disks",
+            "model = \"linear-elastic\"",
+            "model = \"jelly\"",
+            "`materials[0].model`",
+        ),
+        (
+            "colliding-disks",
+            "poisson = 0.3",
+            "poisson = 0.5",
+            "`materials[0].young`",
+        ),
+        (
+            "colliding-disks",
+            "jitter = 0.2",
+            "jitter = 0.6",
+            "`mesh.lattice`",
+        ),
+        (
+            "colliding-disks",
+            "alpha = 0.99",
+            "alpha = 1.5",
+            "`transfer.alpha`",
+        ),
+        (
+            "colliding-disks",
+            "radius = 0.2 } }\nseeding",
+            "radius = 0.0 } }\nseeding",
+            "`bodies[0].region`",
+        ),
+        (
+            "vibrating-bar",
+            "model = \"linear-elastic\"",
+            "model = \"von-mises\"\nyield_stress = 1.0",
+            "`materials`",
+        ),
+        (
+            "vibrating-bar",
+            "scale = 0.1",
+            "scale = -1.0",
+            "`reference.scale`",
+        ),
+        (
+            "cantilever",
+            "group = \"wall\"",
+            "group = \"floor\"",
+            "`boundaries[0].group`",
+        ),
     ] {
         let m = message(scene, find, replace);
         assert!(m.contains(key), "{scene}: `{replace}` gave: {m}");

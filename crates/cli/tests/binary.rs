@@ -1,0 +1,446 @@
+//! The `umls` binary end to end: runs small scenes and reads every file it writes back
+//! with independent parsers (vtkio, roxmltree, csv, serde_json).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use vtkio::model::{Attribute, DataSet, Piece};
+
+fn umls(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_umls"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("binary")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+/// Frames listed in particles.pvd, as (time, file).
+fn frames(dir: &Path) -> Vec<(f64, String)> {
+    let text = std::fs::read_to_string(dir.join("particles.pvd")).unwrap();
+    let doc = roxmltree::Document::parse(&text).unwrap();
+    doc.descendants()
+        .filter(|n| n.has_tag_name("DataSet"))
+        .map(|n| {
+            (
+                n.attribute("timestep").unwrap().parse().unwrap(),
+                n.attribute("file").unwrap().to_string(),
+            )
+        })
+        .collect()
+}
+
+/// Point coordinates (3 per point) of a .vtu file.
+fn points(path: &Path) -> Vec<f64> {
+    let vtk = vtkio::Vtk::import(path).unwrap();
+    let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
+        panic!("not an unstructured grid")
+    };
+    let Piece::Inline(piece) = pieces.into_iter().next().unwrap() else {
+        panic!("not inline")
+    };
+    piece.points.into_vec::<f64>().unwrap()
+}
+
+/// Point count and point arrays (name → values) of a .vtu file.
+fn point_arrays(path: &Path) -> (usize, Vec<(String, Vec<f64>)>) {
+    let vtk = vtkio::Vtk::import(path).unwrap();
+    let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
+        panic!("not an unstructured grid")
+    };
+    let Piece::Inline(piece) = pieces.into_iter().next().unwrap() else {
+        panic!("not inline")
+    };
+    let n = piece.num_points();
+    let arrays = piece
+        .data
+        .point
+        .into_iter()
+        .filter_map(|a| match a {
+            Attribute::DataArray(d) => {
+                let values = d.data.clone().into_vec::<f64>().or_else(|| {
+                    d.data
+                        .into_vec::<i32>()
+                        .map(|v| v.into_iter().map(f64::from).collect())
+                });
+                values.map(|v| (d.name, v))
+            }
+            Attribute::Field { .. } => None,
+        })
+        .collect();
+    (n, arrays)
+}
+
+fn history(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let mut reader = csv::Reader::from_path(dir.join("history.csv")).unwrap();
+    let header = reader.headers().unwrap().iter().map(String::from).collect();
+    let rows = reader
+        .records()
+        .map(|r| r.unwrap().iter().map(|f| f.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn vibrating_bar_writes_readable_files() {
+    let dir = scratch("bar");
+    let out = umls(&[
+        "run",
+        "vibrating-bar",
+        "--out",
+        dir.to_str().unwrap(),
+        "--end-time",
+        "2.5",
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("velocity_rmse"), "{stdout}");
+
+    let s = summary(&dir);
+    assert_eq!(s["status"], "completed");
+    assert_eq!(s["steps"], 500);
+    assert_eq!(s["particles"], 100);
+    assert_eq!(s["kernel"], "umls");
+    assert!(s["particle_steps_per_second"].as_f64().unwrap() > 0.0);
+    let rmse = s["metrics"]["velocity_rmse"].as_f64().unwrap();
+    assert!(rmse > 0.0 && rmse < 2e-3, "{rmse}");
+
+    // 41 frames evenly over [0, 2.5], each at the step nearest its time (Δt = 0.005).
+    let frames = frames(&dir);
+    assert_eq!(frames.len(), 41);
+    for (k, (t, _)) in frames.iter().enumerate() {
+        assert!(
+            (t - 2.5 * k as f64 / 40.0).abs() <= 0.0025 + 1e-9,
+            "frame {k} at {t}"
+        );
+    }
+    assert!((frames[40].0 - 2.5).abs() < 1e-9);
+    // The last frame's velocities against the analytic solution at the particles'
+    // initial positions (position − displacement).
+    let (n, arrays) = point_arrays(&dir.join(&frames[40].1));
+    assert_eq!(n, 100);
+    let get = |name: &str| &arrays.iter().find(|(n, _)| n == name).unwrap().1;
+    let (v, u) = (get("velocity"), get("displacement"));
+    let x = points(&dir.join(&frames[40].1));
+    let t = 2.5;
+    for p in 0..n {
+        let x0 = x[3 * p] - u[3 * p];
+        let exact =
+            0.1 * (std::f64::consts::PI * t / 5.0).cos() * (std::f64::consts::PI * x0 / 50.0).sin();
+        assert!(
+            (v[3 * p] - exact).abs() < 5e-3 * 0.1,
+            "particle {p}: {} vs {exact}",
+            v[3 * p]
+        );
+    }
+    for field in [
+        "cauchy_stress",
+        "deformation_gradient",
+        "jacobian",
+        "mass",
+        "material",
+        "mean_stress",
+    ] {
+        assert!(arrays.iter().any(|(n, _)| n == field), "{field}");
+    }
+
+    let (header, rows) = history(&dir);
+    assert_eq!(
+        &header[..6],
+        ["step", "time", "kinetic", "elastic", "potential", "total"]
+    );
+    assert_eq!(header.last().unwrap(), "velocity_error");
+    assert_eq!(rows.len(), 501);
+    assert!((rows[500][1] - 2.5).abs() < 1e-12);
+    // Energy is nearly conserved: kinetic + elastic stays within 1 % of the start.
+    let e0 = rows[0][5];
+    assert!(rows.iter().all(|r| (r[5] - e0).abs() < 1e-2 * e0));
+
+    let (nodes, mesh_arrays) = point_arrays(&dir.join("mesh.vtu"));
+    assert_eq!(nodes, 109);
+    let mass: f64 = mesh_arrays
+        .iter()
+        .find(|(n, _)| n == "node_mass")
+        .unwrap()
+        .1
+        .iter()
+        .sum();
+    assert!(
+        (mass - 50.0).abs() < 1e-9,
+        "nodal mass {mass} = bar mass 50"
+    );
+}
+
+#[test]
+fn kernel_override_and_conservation() {
+    for kernel in ["linear-fe", "bspline2", "bspline3"] {
+        let dir = scratch(&format!("disks-{kernel}"));
+        let out = umls(&[
+            "run",
+            "colliding-disks",
+            "--kernel",
+            kernel,
+            "--out",
+            dir.to_str().unwrap(),
+            "--end-time",
+            "0.02",
+            "--threads",
+            "1",
+        ]);
+        assert!(
+            out.status.success(),
+            "{kernel}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let s = summary(&dir);
+        assert_eq!(s["kernel"], kernel);
+        assert_eq!(s["threads"], 1);
+        assert!(
+            s["metrics"]["momentum_change"].as_f64().unwrap() < 1e-12,
+            "{kernel}"
+        );
+        let (_, rows) = history(&dir);
+        // Free flight: kinetic energy 2 × ½ · m · |v|² with m = 416/2 · 0.025² · 1000.
+        let expected = 416.0 * 0.025f64.powi(2) * 1000.0 * 0.02 / 2.0;
+        assert!((rows[0][2] - expected).abs() < 1e-12, "{}", rows[0][2]);
+    }
+}
+
+#[test]
+fn plastic_scene_file_on_a_grid_with_slip() {
+    let dir = scratch("column");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("column.toml");
+    std::fs::write(
+        &file,
+        r#"
+[scene]
+name = "sand-column"
+dimension = 2
+end_time = 0.05
+gravity = [0.0, -9.81]
+
+[mesh.lattice]
+lower = [0.0, 0.0]
+upper = [1.0, 0.5]
+cells = [20, 10]
+
+[kernel]
+kind = "bspline2"
+
+[transfer]
+kind = "apic"
+
+[time]
+cfl = 0.4
+
+[output]
+frames = 3
+encoding = "ascii"
+
+[[materials]]
+name = "sand"
+model = "drucker-prager"
+density = 1500.0
+young = 1e6
+poisson = 0.3
+cohesion = 0.0
+friction_angle = 30.0
+
+[[materials]]
+name = "block"
+model = "neo-hookean"
+density = 1000.0
+young = 1e6
+poisson = 0.3
+
+[[bodies]]
+material = "sand"
+region = { box = { lower = [0.0, 0.0], upper = [0.2, 0.4] } }
+seeding = { lattice = 0.025 }
+
+[[bodies]]
+material = "block"
+region = { box = { lower = [0.6, 0.0], upper = [0.8, 0.1] } }
+seeding = { lattice = 0.025 }
+
+[[boundaries]]
+kind = "slip"
+plane = { point = [0.0, 0.0], normal = [0.0, -1.0] }
+
+[[boundaries]]
+kind = "slip"
+plane = { point = [0.0, 0.0], normal = [-1.0, 0.0] }
+"#,
+    )
+    .unwrap();
+    let out = umls(&[
+        "run",
+        file.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = summary(&dir.join("out"));
+    assert_eq!(s["kernel"], "bspline2");
+    assert_eq!(s["materials"], serde_json::json!(["sand", "block"]));
+    let frames = frames(&dir.join("out"));
+    assert_eq!(frames.len(), 3);
+    let (n, arrays) = point_arrays(&dir.join("out").join(&frames[2].1));
+    assert_eq!(n, 8 * 16 + 8 * 4);
+    let get = |name: &str| &arrays.iter().find(|(n, _)| n == name).unwrap().1;
+    let (ids, strain, jp) = (
+        get("material"),
+        get("plastic_strain"),
+        get("plastic_jacobian"),
+    );
+    // The sand column yields under its own weight; the elastic block never does.
+    assert!(ids.iter().zip(strain).any(|(&id, &e)| id == 0.0 && e > 0.0));
+    assert!(
+        ids.iter()
+            .zip(strain)
+            .all(|(&id, &e)| id == 0.0 || e == 0.0)
+    );
+    assert!(ids.iter().zip(jp).all(|(&id, &j)| id == 0.0 || j == 1.0));
+    // The column sinks under gravity, but no particle goes through the floor (slip plane
+    // y = 0) or the wall (slip plane x = 0).
+    assert!(get("displacement").chunks(3).any(|d| d[1] < -1e-4));
+    let x = points(&dir.join("out").join(&frames[2].1));
+    assert!(
+        x.chunks(3).all(|p| p[0] > 0.0 && p[1] > 0.0),
+        "a particle left the box"
+    );
+}
+
+#[test]
+fn scenes_and_help() {
+    let out = umls(&["scenes"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    for name in ["colliding-disks", "vibrating-bar", "cantilever"] {
+        assert!(text.lines().any(|l| l.starts_with(name)), "{text}");
+    }
+    for args in [
+        &["--help"][..],
+        &["run", "--help"],
+        &["scenes", "--help"],
+        &["mesh-info", "--help"],
+    ] {
+        let out = umls(args);
+        assert!(out.status.success(), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stdout).contains("Usage"),
+            "{args:?}"
+        );
+    }
+    let help = String::from_utf8_lossy(&umls(&["run", "--help"]).stdout).into_owned();
+    for option in [
+        "--kernel",
+        "--out",
+        "--end-time",
+        "--threads",
+        "linear-fe",
+        "bspline3",
+    ] {
+        assert!(help.contains(option), "{option} missing from\n{help}");
+    }
+}
+
+#[test]
+fn mesh_info_reports_and_fails_clearly() {
+    let fixture =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../io/tests/fixtures/square-v41-binary.msh");
+    let out = umls(&["mesh-info", fixture.to_str().unwrap()]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("31 vertices, 44 triangles"), "{text}");
+    assert!(text.contains("\"left\""), "{text}");
+    assert!(text.contains("total area: 1"), "{text}");
+
+    let dir = scratch("bad-mesh");
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.msh");
+    let good = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../io/tests/fixtures/square-v22.msh"),
+    )
+    .unwrap();
+    std::fs::write(&bad, good.replacen("$EndNodes", "$EndNode", 1)).unwrap();
+    let out = umls(&["mesh-info", bad.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("line ") && err.contains("$EndNodes"), "{err}");
+}
+
+#[test]
+fn bad_scene_names_and_keys_fail_clearly() {
+    let out = umls(&["run", "no-such-scene"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("colliding-disks") && err.contains("vibrating-bar"),
+        "{err}"
+    );
+
+    let dir = scratch("bad-key");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("typo.toml");
+    let text = umls_cli::builtin::BUILTIN[0]
+        .toml
+        .replacen("[output]", "[output]\nframe = 3", 1);
+    std::fs::write(&file, text).unwrap();
+    let out = umls(&[
+        "run",
+        file.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("unknown field `frame`"), "{err}");
+}
+
+#[test]
+fn an_unstable_run_leaves_its_history_and_says_why() {
+    // Pure FLIP with huge time steps blows up; the files written so far stay.
+    let dir = scratch("unstable");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("unstable.toml");
+    let text = umls_cli::builtin::BUILTIN[0]
+        .toml
+        .replacen("dt = 1e-3", "dt = 0.2", 1)
+        .replacen("alpha = 0.99", "alpha = 1.0", 1);
+    std::fs::write(&file, text).unwrap();
+    let out = umls(&[
+        "run",
+        file.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("simulation stopped: step"), "{err}");
+    let s = summary(&dir.join("out"));
+    assert_eq!(s["status"], "failed");
+    assert!(s["error"].as_str().unwrap().contains("step"));
+    let (_, rows) = history(&dir.join("out"));
+    assert!(!rows.is_empty());
+}
