@@ -364,7 +364,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     let mut history = HistoryWriter::create(out.path("history.csv"), &header_refs)?;
 
     let reference_positions = seeds.position.clone();
-    let frames = spec.output.frames;
+    let frames = setup::frame_count(scene, ctx.end_time);
     let frame_time = |k: usize| ctx.end_time * k as f64 / (frames - 1) as f64;
     let mut next_frame = 1;
     let record = |sim: &Simulation<D, K, MaterialTable<P>, T>,

@@ -179,17 +179,14 @@ pub struct TimeSpec {
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     /// Particle frames written over the run, the initial state included (default 50).
-    #[serde(default = "default_frames")]
-    pub frames: usize,
+    pub frames: Option<usize>,
+    /// Time between particle frames (instead of `frames`).
+    pub interval: Option<f64>,
     /// Write diagnostics to `history.csv` every this many steps (default 1).
     #[serde(default = "default_history_every")]
     pub history_every: usize,
     /// "binary" (default) or "ascii" VTK data arrays.
     pub encoding: Option<String>,
-}
-
-fn default_frames() -> usize {
-    50
 }
 
 fn default_history_every() -> usize {
@@ -199,7 +196,8 @@ fn default_history_every() -> usize {
 impl Default for OutputSpec {
     fn default() -> Self {
         Self {
-            frames: default_frames(),
+            frames: None,
+            interval: None,
             history_every: default_history_every(),
             encoding: None,
         }

@@ -504,8 +504,19 @@ pub fn check_header(scene: &Scene) -> Result<()> {
         (None, Some(_)) => return Err(scene.value_error("time.cfl", "must be in (0, 1]")),
         _ => return Err(scene.value_error("time", "give exactly one of `dt` and `cfl`")),
     }
-    if spec.output.frames < 2 {
-        return Err(scene.value_error("output.frames", "at least 2 (the first and the last state)"));
+    match (spec.output.frames, spec.output.interval) {
+        (Some(_), Some(_)) => {
+            return Err(scene.value_error("output", "give at most one of `frames` and `interval`"));
+        }
+        (Some(n), None) if n < 2 => {
+            return Err(
+                scene.value_error("output.frames", "at least 2 (the first and the last state)")
+            );
+        }
+        (None, Some(i)) if !(i.is_finite() && i > 0.0) => {
+            return Err(scene.value_error("output.interval", "must be finite and positive"));
+        }
+        _ => {}
     }
     if spec.output.history_every == 0 {
         return Err(scene.value_error("output.history_every", "must be at least 1"));
@@ -517,6 +528,19 @@ pub fn check_header(scene: &Scene) -> Result<()> {
         return Err(scene.value_error("scene.dimension", "must be 1, 2 or 3"));
     }
     Ok(())
+}
+
+/// Default number of particle frames.
+pub const DEFAULT_FRAMES: usize = 50;
+
+/// Particle frames over a run ending at `end_time`: `frames`, or one per `interval`
+/// (the initial state included).
+pub fn frame_count(scene: &Scene, end_time: f64) -> usize {
+    match (scene.spec.output.frames, scene.spec.output.interval) {
+        (Some(n), _) => n,
+        (None, Some(i)) => ((end_time / i).round().max(1.0) as usize) + 1,
+        (None, None) => DEFAULT_FRAMES,
+    }
 }
 
 /// The error for a scene that is plastic in 1D.

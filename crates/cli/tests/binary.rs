@@ -444,3 +444,168 @@ fn an_unstable_run_leaves_its_history_and_says_why() {
     let (_, rows) = history(&dir.join("out"));
     assert!(!rows.is_empty());
 }
+
+/// Writes `text` as `name` in a fresh scratch directory whose `meshes/` holds the
+/// umls-io Gmsh fixtures, and returns the scene path.
+fn scene_with_fixtures(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let meshes = dir.join("meshes");
+    std::fs::create_dir_all(&meshes).unwrap();
+    for f in ["cube-v41-binary.msh", "square-v22.msh"] {
+        let from = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../io/tests/fixtures")
+            .join(f);
+        std::fs::copy(from, meshes.join(f)).unwrap();
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+const BLOCK: &str = r#"
+[scene]
+name = "block"
+dimension = 3
+end_time = 0.02
+gravity = [0.0, 0.0, -9.81]
+
+[mesh]
+file = "meshes/cube-v41-binary.msh"
+
+[time]
+cfl = 0.3
+
+[output]
+interval = 0.01
+
+[[materials]]
+name = "rubber"
+model = "neo-hookean"
+density = 1000.0
+young = 1e7
+poisson = 0.3
+
+[[bodies]]
+material = "rubber"
+region = { box = { lower = [0.25, 0.25, 0.0], upper = [0.75, 0.75, 0.5] } }
+seeding = { lattice = 0.125 }
+
+[[boundaries]]
+kind = "slip"
+group = "base"
+"#;
+
+#[test]
+fn three_dimensional_gmsh_scene_with_group_slip() {
+    // The same block with and without the slip condition on the mesh's `base` group.
+    let mut momentum = Vec::new();
+    for (name, text) in [
+        ("supported", BLOCK.to_string()),
+        (
+            "falling",
+            BLOCK.replace("[[boundaries]]\nkind = \"slip\"\ngroup = \"base\"\n", ""),
+        ),
+    ] {
+        let dir = scratch(&format!("cube-{name}"));
+        let file = scene_with_fixtures(&dir, "block.toml", &text);
+        let out = umls(&[
+            "run",
+            file.to_str().unwrap(),
+            "--out",
+            dir.join("out").to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let s = summary(&dir.join("out"));
+        assert_eq!(
+            (s["dimension"].as_u64(), s["particles"].as_u64()),
+            (Some(3), Some(64))
+        );
+        // `interval = 0.01` over 0.02: three frames.
+        assert_eq!(frames(&dir.join("out")).len(), 3);
+        let (header, rows) = history(&dir.join("out"));
+        assert_eq!(header[8], "momentum_z");
+        let last = rows.last().unwrap();
+        momentum.push((last[8], rows[0][9] * 9.81 * last[1]));
+        let (nodes, arrays) = point_arrays(&dir.join("out").join("mesh.vtu"));
+        let base = &arrays.iter().find(|(n, _)| n == "group base").unwrap().1;
+        assert_eq!(base.len(), nodes);
+        assert!(base.iter().any(|&f| f == 1.0));
+    }
+    // Free fall: p_z = −M g t to round-off. On the slip base the block rests; its vertical
+    // momentum only oscillates with the elastic vibration (amplitude ≈ M g / ω, ω ≈ πc/2H).
+    let (falling, free_fall) = momentum[1];
+    assert!(
+        (falling + free_fall).abs() < 1e-9 * free_fall,
+        "{falling} vs −{free_fall}"
+    );
+    let (supported, _) = momentum[0];
+    assert!(
+        supported.abs() < 0.3 * free_fall,
+        "p_z = {supported}, free fall −{free_fall}"
+    );
+}
+
+#[test]
+fn group_region_seeds_the_groups_cells() {
+    let dir = scratch("square-group");
+    let file = scene_with_fixtures(
+        &dir,
+        "square.toml",
+        r#"
+[scene]
+name = "square"
+dimension = 2
+end_time = 0.001
+
+[mesh]
+file = "meshes/square-v22.msh"
+
+[time]
+dt = 1e-4
+
+[output]
+frames = 2
+
+[[materials]]
+name = "m"
+model = "linear-elastic"
+density = 2.0
+young = 1.0
+poisson = 0.2
+
+[[bodies]]
+material = "m"
+region = { group = "domain" }
+seeding = { mesh = "gauss2" }
+velocity = ["y", "-x"]
+"#,
+    );
+    let out = umls(&[
+        "run",
+        file.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+        "--kernel",
+        "linear-fe",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = summary(&dir.join("out"));
+    // 44 triangles × 3 Gauss points; the mass is density × area.
+    assert_eq!(s["particles"], 132);
+    let (_, rows) = history(&dir.join("out"));
+    assert!((rows[0][8] - 2.0).abs() < 1e-12, "mass {}", rows[0][8]);
+    // A rigid rotation v = (y, −x) about the origin: kinetic energy ½ ρ ∫ |x|² = ρ/3 · … on
+    // the unit square, ½ · 2 · ∫∫ (x² + y²) = 2/3; the degree-2 rule integrates it exactly.
+    assert!(
+        (rows[0][2] - 2.0 / 3.0).abs() < 1e-12,
+        "kinetic {}",
+        rows[0][2]
+    );
+}
