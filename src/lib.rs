@@ -14,7 +14,10 @@
 //! - [`transfer`] (`umls-transfer`), [`kernels`] (`umls-kernels`), [`engine`]
 //!   (`umls-engine`): the kernel port, the UMLS / linear-FE / B-spline kernels, and the
 //!   explicit MPM engine;
-//! - [`scenes`] (`umls-scenes`): the benchmark scenes with their references.
+//! - [`scenes`] (`umls-scenes`): the benchmark scenes with their references;
+//! - [`io`] (`umls-io`): Gmsh mesh reading, VTK (`.vtu`, `.pvd`) and CSV writing.
+//!
+//! The `umls` command line is the separate `umls-cli` crate (`crates/cli`).
 //!
 //! ```
 //! use umls::mesh::generate::{Diagonal, Lattice};
@@ -30,6 +33,7 @@
 
 pub use umls_constitutive as constitutive;
 pub use umls_engine as engine;
+pub use umls_io as io;
 pub use umls_kernels as kernels;
 pub use umls_manifold as manifold;
 pub use umls_mesh as mesh;

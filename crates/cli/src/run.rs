@@ -190,6 +190,9 @@ fn run_dim<const D: usize, X: Dimension<D>>(
     }
 }
 
+/// Most nodes a B-spline grid may have (a typo in the spacing should be an error).
+const MAX_GRID_NODES: f64 = 1e8;
+
 /// A B-spline grid covering the mesh's bounding box with two cells of margin (the
 /// widest, cubic, stencil needs one).
 fn bspline<const D: usize>(ctx: &Context<'_, D>, order: BSplineOrder) -> Result<BSplineKernel<D>> {
@@ -212,6 +215,13 @@ fn bspline<const D: usize>(ctx: &Context<'_, D>, order: BSplineOrder) -> Result<
     let cells: [usize; D] = std::array::from_fn(|k| {
         ((upper[k] - lower[k]) / h - 1e-9).ceil().max(1.0) as usize + 2 * MARGIN
     });
+    let nodes: f64 = cells.iter().map(|&n| n as f64 + 1.0).product();
+    if nodes > MAX_GRID_NODES {
+        return Err(ctx.scene.value_error(
+            "kernel.grid_spacing",
+            format!("{h} gives a grid of {nodes:.3e} nodes (limit {MAX_GRID_NODES:.0e})"),
+        ));
+    }
     BSplineKernel::new(origin, h, cells, order).ok_or_else(|| {
         ctx.scene
             .value_error("kernel.grid_spacing", "too coarse for one B-spline stencil")

@@ -19,6 +19,12 @@ use crate::material::{ElasticModel, Model, PlasticModel};
 use crate::scene::Scene;
 use crate::schema::{BoundaryKind, RegionSpec, SeedingSpec};
 
+/// Most lattice points a seeding may generate before filtering by region, and most cells
+/// of a generated lattice mesh: a typo in a spacing or count should be an error, not an
+/// exhausted memory (2·10⁷ tetrahedra already take several GB). Larger runs use the
+/// library directly.
+pub const MAX_LATTICE_POINTS: f64 = 2e7;
+
 /// Particles as plain arrays, before they meet a kernel and a material type.
 #[derive(Debug, Clone, Default)]
 pub struct Seeds<const D: usize> {
@@ -126,6 +132,13 @@ fn mesh<const D: usize>(
                 return Err(scene.value_error("mesh.lattice.cells", format!("needs {D} counts")));
             }
             let cells: [usize; D] = std::array::from_fn(|k| l.cells[k]);
+            let total = cells.iter().map(|&n| n as f64).product::<f64>();
+            if total > MAX_LATTICE_POINTS {
+                return Err(scene.value_error(
+                    "mesh.lattice.cells",
+                    format!("{total:.3e} cells (limit {MAX_LATTICE_POINTS:.0e})"),
+                ));
+            }
             let spacing = (0..D)
                 .map(|k| (upper[k] - lower[k]) / cells[k].max(1) as f64)
                 .fold(f64::INFINITY, f64::min);
@@ -308,6 +321,15 @@ fn seed_body<const D: usize>(
                 return Err(scene.value_error(key("seeding.lattice"), "spacing must be positive"));
             }
             let (lower, upper) = mesh.bounding_box();
+            let count: f64 = (0..D)
+                .map(|k| ((upper[k] - lower[k]) / h).round().max(1.0))
+                .product();
+            if count > MAX_LATTICE_POINTS {
+                return Err(scene.value_error(
+                    key("seeding.lattice"),
+                    format!("spacing {h} puts {count:.3e} lattice points over the mesh (limit {MAX_LATTICE_POINTS:.0e})"),
+                ));
+            }
             lattice_samples(lower, upper, *h)
         }
         SeedingSpec::Mesh(rule) => {

@@ -215,6 +215,30 @@ fn bad_values_name_their_key() {
             "group = \"floor\"",
             "`boundaries[0].group`",
         ),
+        (
+            "colliding-disks",
+            "lattice = 0.025",
+            "lattice = 1e-9",
+            "`bodies[0].seeding.lattice`",
+        ),
+        (
+            "colliding-disks",
+            "cells = [20, 20]",
+            "cells = [0, 20]",
+            "`mesh.lattice`",
+        ),
+        (
+            "colliding-disks",
+            "kind = \"umls\"",
+            "kind = \"bspline2\"\ngrid_spacing = 1e-9",
+            "`kernel.grid_spacing`",
+        ),
+        (
+            "colliding-disks",
+            "frames = 61",
+            "frames = 61\ninterval = 0.1",
+            "`output`",
+        ),
     ] {
         let m = message(scene, find, replace);
         assert!(m.contains(key), "{scene}: `{replace}` gave: {m}");
