@@ -43,6 +43,14 @@ pub enum CliError {
     /// The simulation stopped.
     #[error("simulation stopped: {0}")]
     Engine(#[from] umls_engine::EngineError),
+    /// The energy plot could not be drawn.
+    #[error("{path}: plotting failed: {message}")]
+    Plot {
+        /// The SVG file.
+        path: PathBuf,
+        /// The plotting library's message.
+        message: String,
+    },
     /// A file or directory could not be written.
     #[error("{path}: {source}")]
     File {

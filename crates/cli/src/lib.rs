@@ -2,12 +2,12 @@
 //!
 //! - `umls run SCENE` runs a built-in scene or a TOML scene file ([`schema`]) with any
 //!   kernel and writes ParaView files (`particles.pvd` with `.vtu` frames, `mesh.vtu`),
-//!   `history.csv` and `summary.json` ([`run`]).
+//!   `history.csv`, `energies.svg` and `summary.json` ([`run`]).
 //! - `umls scenes` lists the built-in scenes ([`builtin`]).
 //! - `umls mesh-info FILE.msh` describes a Gmsh mesh ([`mesh_info`]).
 //!
 //! Dependencies beyond the workspace's: `clap` (argument parsing and `--help`),
-//! `indicatif` (progress bar), `toml` + `serde` (scene files, with unknown keys
+//! `indicatif` (progress bar), `plotters` (the energy plot), `toml` + `serde` (scene files, with unknown keys
 //! rejected), `serde_json` (the run summary) and `exmex` (velocity expressions such as
 //! `"0.1 * sin(PI * x / 50)"`): each a maintained crate that does its job better than a
 //! hand-written one would.
@@ -32,6 +32,7 @@ pub mod expression;
 pub mod material;
 pub mod mesh_info;
 mod output;
+pub mod plot;
 mod progress;
 pub mod run;
 pub mod scene;

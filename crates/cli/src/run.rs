@@ -24,6 +24,7 @@ use umls_transfer::Kernel;
 use crate::error::{CliError, Result};
 use crate::material::{MaterialTable, Model, NoPlasticity, PlasticModel, PlasticPart, TableState};
 use crate::output::OutputDir;
+use crate::plot::EnergyRecord;
 use crate::progress::Progress;
 use crate::scene::Scene;
 use crate::schema::{BoundaryKind, KernelKind, TransferKind};
@@ -380,7 +381,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     let record = |sim: &Simulation<D, K, MaterialTable<P>, T>,
                   history: &mut HistoryWriter,
                   error: Option<f64>|
-     -> Result<(f64, Diagnostics<D>)> {
+     -> Result<(f64, Diagnostics<D>, EnergyRecord)> {
         let d = sim.diagnostics()?;
         let (potential, total) = total_energy(
             &d,
@@ -400,7 +401,14 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         row.extend([d.mass, d.max_speed, d.courant]);
         row.extend(error);
         history.row(&row)?;
-        Ok((total, d))
+        let record = EnergyRecord {
+            time: d.time,
+            kinetic: d.kinetic,
+            elastic: d.elastic,
+            potential,
+            total,
+        };
+        Ok((total, d, record))
     };
 
     // The reference error at the current time: RMS over particles of |v − v_ref(X, t)|.
@@ -419,7 +427,8 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     };
 
     out.write_particles(&sim, &reference_positions)?;
-    let (e0, d0) = record(&sim, &mut history, reference_error(&sim)?)?;
+    let (e0, d0, r0) = record(&sim, &mut history, reference_error(&sim)?)?;
+    let mut energies = vec![r0];
     // Energy error: the largest |E(t) − E(0)| over the largest mechanical energy
     // (kinetic + elastic) of the run, which stays meaningful when E(0) is 0 (a body
     // released from rest under gravity).
@@ -441,7 +450,8 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
             error_max = error_max.max(e);
         }
         if step % spec.output.history_every == 0 || step == steps {
-            let (total, d) = record(&sim, &mut history, error)?;
+            let (total, d, r) = record(&sim, &mut history, error)?;
+            energies.push(r);
             energy_change = energy_change.max((total - e0).abs());
             last_total = total;
             energy_scale = energy_scale.max(d.kinetic + d.elastic);
@@ -462,6 +472,17 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     } else {
         out.write_mesh(&setup.mesh, &setup.groups, None)?;
     }
+    crate::plot::energy_plot(
+        &out.path("energies.svg"),
+        &format!(
+            "{}: energies ({}, {})",
+            spec.scene.name,
+            ctx.kernel.name(),
+            transfer_name(&spec.transfer)
+        ),
+        &energies,
+        setup.gravity.norm() > 0.0,
+    )?;
     let taken = sim.step_count();
     let mut metrics = serde_json::Map::new();
     let energy_error = if energy_scale > 0.0 {
@@ -509,6 +530,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
             "frames": out.frames(),
             "mesh": "mesh.vtu",
             "history": "history.csv",
+            "energy_plot": "energies.svg",
         },
     });
     let text = serde_json::to_string_pretty(&summary).unwrap_or_default();

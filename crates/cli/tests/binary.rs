@@ -171,6 +171,15 @@ fn vibrating_bar_writes_readable_files() {
     let e0 = rows[0][5];
     assert!(rows.iter().all(|r| (r[5] - e0).abs() < 1e-2 * e0));
 
+    // The energy plot is well-formed SVG with the three curves.
+    let svg = std::fs::read_to_string(dir.join("energies.svg")).unwrap();
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    assert_eq!(doc.root_element().tag_name().name(), "svg");
+    for label in ["kinetic", "elastic", "total"] {
+        assert!(svg.contains(label), "{label}");
+    }
+    assert!(!svg.contains("potential"), "no gravity, no potential curve");
+
     let (nodes, mesh_arrays) = point_arrays(&dir.join("mesh.vtu"));
     assert_eq!(nodes, 109);
     let mass: f64 = mesh_arrays
