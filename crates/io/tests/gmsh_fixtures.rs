@@ -199,3 +199,43 @@ fn missing_file_names_the_path() {
     let err = read_msh::<2>("no/such/file.msh", ReadOptions::default()).unwrap_err();
     assert!(err.to_string().starts_with("no/such/file.msh"), "{err}");
 }
+
+#[test]
+fn partitioned_files_keep_their_physical_groups() {
+    let whole = read_msh::<2>(fixture("square-v41.msh"), ReadOptions::default()).unwrap();
+    for suffix in ["v41", "v41-binary"] {
+        let name = format!("square-partitioned-{suffix}.msh");
+        let parts = read_msh::<2>(fixture(&name), ReadOptions::default()).unwrap();
+        // The same triangles (listed per partition, so in another order) and groups.
+        assert_eq!(parts.mesh.simplex_count(), whole.mesh.simplex_count());
+        assert!((parts.mesh.total_volume() - 1.0).abs() < 1e-12);
+        for g in &whole.groups {
+            let p = parts
+                .group(&g.name)
+                .unwrap_or_else(|| panic!("{name}: no {}", g.name));
+            assert_eq!((p.dimension, p.tag), (g.dimension, g.tag));
+            assert_eq!(p.vertices.len(), g.vertices.len(), "{name}: {}", g.name);
+            assert_eq!(p.cells.len(), g.cells.len(), "{name}: {}", g.name);
+            assert_eq!(p.elements.len(), g.elements.len(), "{name}: {}", g.name);
+            // Coordinates on a 1e-12 grid: ASCII files carry 16 digits, binary ones all.
+            let coordinates = |m: &GmshMesh<2>, group: &umls_io::gmsh::PhysicalGroup| {
+                let mut xs: Vec<(i64, i64)> = group
+                    .vertices
+                    .iter()
+                    .map(|&v| {
+                        let x = m.mesh.vertex(v as usize);
+                        ((x[0] * 1e12).round() as i64, (x[1] * 1e12).round() as i64)
+                    })
+                    .collect();
+                xs.sort_unstable();
+                xs
+            };
+            assert_eq!(
+                coordinates(&parts, p),
+                coordinates(&whole, g),
+                "{name}: {}",
+                g.name
+            );
+        }
+    }
+}

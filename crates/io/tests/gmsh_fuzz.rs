@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use proptest::prelude::*;
 use umls_io::gmsh::{AnyGmshMesh, ReadOptions, parse_msh_any};
 
-const FIXTURES: [&str; 7] = [
+const FIXTURES: [&str; 8] = [
     "square-v41.msh",
     "square-v41-binary.msh",
     "square-v22.msh",
@@ -14,6 +14,7 @@ const FIXTURES: [&str; 7] = [
     "cube-v22.msh",
     "bar-v41.msh",
     "quads-v41.msh",
+    "square-partitioned-v41-binary.msh",
 ];
 
 fn fixture(index: usize) -> Vec<u8> {

@@ -116,6 +116,7 @@ pub(crate) fn parse_raw(bytes: &[u8]) -> Result<(MshVersion, RawMsh)> {
         let section: &'static str = match name.as_str() {
             "PhysicalNames" => "PhysicalNames",
             "Entities" if version != MshVersion::V22 => "Entities",
+            "PartitionedEntities" if version != MshVersion::V22 => "PartitionedEntities",
             "Nodes" => "Nodes",
             "Elements" => "Elements",
             _ => {
@@ -126,7 +127,10 @@ pub(crate) fn parse_raw(bytes: &[u8]) -> Result<(MshVersion, RawMsh)> {
         c.section = section;
         match section {
             "PhysicalNames" => read_physical_names(&mut c, &mut raw)?,
-            "Entities" => physicals = v4::read_entities(&mut c)?,
+            // Model and partitioned entities have distinct tags; elements of a partitioned
+            // file refer to the latter.
+            "Entities" => physicals.extend(v4::read_entities(&mut c)?),
+            "PartitionedEntities" => physicals.extend(v4::read_partitioned_entities(&mut c)?),
             "Nodes" if has_nodes => return Err(c.malformed("a second $Nodes section")),
             "Elements" if has_elements => return Err(c.malformed("a second $Elements section")),
             "Nodes" if version == MshVersion::V22 => v2::read_nodes(&mut c, &mut raw)?,

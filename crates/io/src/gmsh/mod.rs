@@ -1,4 +1,9 @@
-//! Gmsh MSH readers: format 4.1 (ASCII and binary) and 2.2 (ASCII).
+//! Gmsh MSH readers: format 4.1 (ASCII and binary, either byte order, partitioned or
+//! not) and 2.2 (ASCII).
+//!
+//! Sections other than `$MeshFormat`, `$PhysicalNames`, `$Entities`,
+//! `$PartitionedEntities`, `$Nodes` and `$Elements` (node data, periodicity, ghost
+//! elements, parametrisations, comments) are skipped.
 //!
 //! Written here rather than taken from `mshio` because that crate reads 4.1 only, and
 //! because every error must name the line (or byte) and section at fault; the parser is

@@ -94,6 +94,52 @@ pub(crate) fn read_entities(c: &mut Cursor<'_>) -> Result<EntityPhysicals> {
     Ok(physicals)
 }
 
+/// `$PartitionedEntities`: in a partitioned file the element blocks refer to these
+/// entities, each with its own physical tags.
+pub(crate) fn read_partitioned_entities(c: &mut Cursor<'_>) -> Result<EntityPhysicals> {
+    c.start_binary();
+    count(c, "the number of partitions", 0)?;
+    let ghosts = count(c, "the number of ghost entities", 8)?;
+    for _ in 0..ghosts {
+        int(c, "a ghost entity tag")?;
+        int(c, "a ghost entity partition")?;
+    }
+    let counts = [
+        count(c, "the number of partitioned point entities", 4)?,
+        count(c, "the number of partitioned curve entities", 4)?,
+        count(c, "the number of partitioned surface entities", 4)?,
+        count(c, "the number of partitioned volume entities", 4)?,
+    ];
+    let mut physicals = EntityPhysicals::new();
+    for (dim, &n) in counts.iter().enumerate() {
+        for _ in 0..n {
+            let tag = int(c, "a partitioned entity tag")?;
+            dimension(c)?;
+            int(c, "a parent entity tag")?;
+            let partitions = count(c, "the number of partitions of the entity", 4)?;
+            for _ in 0..partitions {
+                int(c, "a partition tag")?;
+            }
+            let coordinates = if dim == 0 { 3 } else { 6 };
+            for _ in 0..coordinates {
+                double(c, "an entity coordinate")?;
+            }
+            let n_physical = count(c, "the number of physical tags", 4)?;
+            let tags = (0..n_physical)
+                .map(|_| int(c, "a physical tag"))
+                .collect::<Result<Vec<i32>>>()?;
+            physicals.insert((dim, tag), tags);
+            if dim > 0 {
+                let n_bounding = count(c, "the number of bounding entities", 4)?;
+                for _ in 0..n_bounding {
+                    int(c, "a bounding entity tag")?;
+                }
+            }
+        }
+    }
+    Ok(physicals)
+}
+
 pub(crate) fn read_nodes(c: &mut Cursor<'_>, raw: &mut RawMsh) -> Result<()> {
     c.start_binary();
     let blocks = count(c, "the number of node blocks", 4)?;
