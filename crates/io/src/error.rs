@@ -166,8 +166,11 @@ pub enum IoError {
         node: u64,
     },
     /// The cells do not form a valid mesh (degenerate, inverted, non-manifold, …).
-    #[error("element {element}: {source}")]
+    #[error("{at}: element {element}: {source}")]
     InvalidMesh {
+        /// Where the offending element is defined (the `$Elements` header if the problem
+        /// is not tied to one element).
+        at: Position,
         /// Tag of the offending element (0 if the problem is not tied to one).
         element: u64,
         /// The mesh validation error.

@@ -159,6 +159,7 @@ fn clockwise_triangles_are_fixed_or_rejected() {
             err,
             IoError::InvalidMesh {
                 element: 3,
+                at: Position::Line(21),
                 source: MeshError::InvertedSimplex { simplex: 1, .. }
             }
         ),
@@ -175,6 +176,7 @@ fn degenerate_triangle_names_its_element() {
             err,
             IoError::InvalidMesh {
                 element: 4,
+                at: Position::Line(22),
                 source: MeshError::DegenerateSimplex { simplex: 2, .. }
             }
         ),

@@ -128,8 +128,10 @@ pub(crate) fn to_mesh<const D: usize>(
         .collect();
     let cell_tags: Vec<u64> = cells.iter().map(|c| c.tag).collect();
     let mesh = SimplexMesh::new(vertices, connectivity, options.orientation).map_err(|source| {
+        let cell = simplex_of(&source).map(|s| cells[s]);
         IoError::InvalidMesh {
-            element: simplex_of(&source).map_or(0, |s| cell_tags[s]),
+            at: cell.map_or(cells[0].at, |c| c.at),
+            element: cell.map_or(0, |c| c.tag),
             source,
         }
     })?;
