@@ -1,7 +1,7 @@
-//! The main job: the colliding-disks benchmark (Sulsky et al. 1994) on an unstructured,
+//! Kernel comparison on the colliding-disks benchmark (Sulsky et al. 1994) on an unstructured,
 //! jittered triangle mesh, run with the UMLS kernel and with linear finite elements.
 //!
-//! `cargo run --release --example colliding_disks [OUT_DIR]` (default `out/colliding-disks`)
+//! `cargo run --release --example colliding_disks [OUT_DIR]` (default `out/kernel-comparison`)
 //! prints the energy history and the cell-crossing comparison, and writes
 //! - `energies.svg`: kinetic, strain and total energy against time for both kernels;
 //! - `stress.svg`: the mean-stress history of one particle whose path crosses many
@@ -101,7 +101,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let out = PathBuf::from(
         std::env::args()
             .nth(1)
-            .unwrap_or_else(|| "out/colliding-disks".into()),
+            .unwrap_or_else(|| "out/kernel-comparison".into()),
     );
     std::fs::create_dir_all(&out)?;
     let scene = CollidingDisks::default();
