@@ -152,4 +152,19 @@ impl OutputDir {
         grid.write_vtu(self.path("mesh.vtu"), self.encoding)?;
         Ok(())
     }
+
+    /// Writes `grid.vtu` for grid kernels: the nodes as points with the last step's
+    /// nodal mass and velocity (the mesh kernels' `mesh.vtu` carries these instead).
+    pub fn write_grid<const D: usize>(
+        &self,
+        nodes: &[SVector<f64, D>],
+        mass: &[f64],
+        velocity: &[SVector<f64, D>],
+    ) -> Result<()> {
+        let mut grid = UnstructuredGrid::point_cloud(nodes.iter().map(pad_vector).collect());
+        grid.add_point_field("node_mass", 1, mass.to_vec())?;
+        grid.add_point_vectors("node_velocity", velocity)?;
+        grid.write_vtu(self.path("grid.vtu"), self.encoding)?;
+        Ok(())
+    }
 }

@@ -471,6 +471,10 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         out.write_mesh(&setup.mesh, &setup.groups, Some((mass, velocity)))?;
     } else {
         out.write_mesh(&setup.mesh, &setup.groups, None)?;
+        let nodes: Vec<SVector<f64, D>> = (0..sim.kernel.node_count())
+            .map(|n| sim.kernel.node_position(n))
+            .collect();
+        out.write_grid(&nodes, mass, velocity)?;
     }
     crate::plot::energy_plot(
         &out.path("energies.svg"),
@@ -529,6 +533,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
             "particles": "particles.pvd",
             "frames": out.frames(),
             "mesh": "mesh.vtu",
+            "grid": if mesh_kernel { None } else { Some("grid.vtu") },
             "history": "history.csv",
             "energy_plot": "energies.svg",
         },

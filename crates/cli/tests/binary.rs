@@ -219,6 +219,24 @@ fn kernel_override_and_conservation() {
         let s = summary(&dir);
         assert_eq!(s["kernel"], kernel);
         assert_eq!(s["threads"], 1);
+        // Grid kernels write their nodes with the nodal mass: all of the disks' mass.
+        if kernel.starts_with("bspline") {
+            assert_eq!(s["outputs"]["grid"], "grid.vtu");
+            let (_, arrays) = point_arrays(&dir.join("grid.vtu"));
+            let mass: f64 = arrays
+                .iter()
+                .find(|(n, _)| n == "node_mass")
+                .unwrap()
+                .1
+                .iter()
+                .sum();
+            assert!(
+                (mass - 416.0 * 0.025f64.powi(2) * 1000.0).abs() < 1e-9,
+                "{kernel}: {mass}"
+            );
+        } else {
+            assert!(s["outputs"]["grid"].is_null());
+        }
         assert!(
             s["metrics"]["momentum_change"].as_f64().unwrap() < 1e-12,
             "{kernel}"
