@@ -17,8 +17,7 @@ use umls_engine::{
 use umls_io::csv::HistoryWriter;
 use umls_io::vtk::Encoding;
 use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, Umls1, Umls2, Umls3};
-use umls_mesh::generate::{Diagonal, Lattice};
-use umls_mesh::{MeshError, SimplexMesh};
+use umls_mesh::SimplexMesh;
 use umls_transfer::Kernel;
 
 use crate::error::{CliError, Result};
@@ -67,19 +66,9 @@ struct D1;
 struct D2;
 struct D3;
 
-fn split1(l: &Lattice<1>, _: Diagonal) -> std::result::Result<SimplexMesh<1>, MeshError> {
-    l.segments()
-}
-fn split2(l: &Lattice<2>, d: Diagonal) -> std::result::Result<SimplexMesh<2>, MeshError> {
-    l.triangles(d)
-}
-fn split3(l: &Lattice<3>, _: Diagonal) -> std::result::Result<SimplexMesh<3>, MeshError> {
-    l.tetrahedra()
-}
-
 impl Dimension<1> for D1 {
     type Umls = Umls1;
-    const SPLIT: Split<1> = split1;
+    const SPLIT: Split<1> = setup::segments;
     fn umls(mesh: Arc<SimplexMesh<1>>) -> Umls1 {
         Umls1::new(mesh)
     }
@@ -90,7 +79,7 @@ impl Dimension<1> for D1 {
 
 impl Dimension<2> for D2 {
     type Umls = Umls2;
-    const SPLIT: Split<2> = split2;
+    const SPLIT: Split<2> = setup::triangles;
     fn umls(mesh: Arc<SimplexMesh<2>>) -> Umls2 {
         Umls2::new(mesh)
     }
@@ -107,7 +96,7 @@ impl Dimension<2> for D2 {
 
 impl Dimension<3> for D3 {
     type Umls = Umls3;
-    const SPLIT: Split<3> = split3;
+    const SPLIT: Split<3> = setup::tetrahedra;
     fn umls(mesh: Arc<SimplexMesh<3>>) -> Umls3 {
         Umls3::new(mesh)
     }

@@ -107,6 +107,30 @@ fn vector<const D: usize>(scene: &Scene, key: &str, values: &[f64]) -> Result<SV
 pub type Split<const D: usize> =
     fn(&Lattice<D>, Diagonal) -> std::result::Result<SimplexMesh<D>, umls_mesh::MeshError>;
 
+/// [`Split`] for D = 1: segments.
+pub fn segments(
+    l: &Lattice<1>,
+    _: Diagonal,
+) -> std::result::Result<SimplexMesh<1>, umls_mesh::MeshError> {
+    l.segments()
+}
+
+/// [`Split`] for D = 2: triangles with the given diagonals.
+pub fn triangles(
+    l: &Lattice<2>,
+    d: Diagonal,
+) -> std::result::Result<SimplexMesh<2>, umls_mesh::MeshError> {
+    l.triangles(d)
+}
+
+/// [`Split`] for D = 3: Kuhn tetrahedra.
+pub fn tetrahedra(
+    l: &Lattice<3>,
+    _: Diagonal,
+) -> std::result::Result<SimplexMesh<3>, umls_mesh::MeshError> {
+    l.tetrahedra()
+}
+
 fn mesh<const D: usize>(
     scene: &Scene,
     split: Split<D>,

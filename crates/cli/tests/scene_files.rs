@@ -4,10 +4,9 @@
 use umls_cli::CliError;
 use umls_cli::run::{RunOptions, run};
 use umls_cli::scene::Scene;
-use umls_cli::setup::build;
+use umls_cli::setup::{build, triangles};
 use umls_engine::Apic;
 use umls_kernels::{Umls1, Umls2};
-use umls_mesh::generate::Diagonal;
 use umls_scenes::colliding_disks::CollidingDisks;
 use umls_scenes::vibrating_bar::VibratingBar;
 
@@ -21,17 +20,10 @@ fn options(name: &str, end_time: Option<f64>) -> RunOptions {
     }
 }
 
-fn split2(
-    l: &umls_mesh::generate::Lattice<2>,
-    d: Diagonal,
-) -> Result<umls_mesh::SimplexMesh<2>, umls_mesh::MeshError> {
-    l.triangles(d)
-}
-
 #[test]
 fn disks_file_builds_the_hand_written_scene() {
     let scene = Scene::load("colliding-disks").unwrap();
-    let setup = build::<2>(&scene, split2).unwrap();
+    let setup = build::<2>(&scene, triangles).unwrap();
     let reference = CollidingDisks::default();
     let particles = reference.particles::<()>();
     // The same lattice points, from different origins: equal to round-off, same order.

@@ -6,19 +6,7 @@
 use proptest::prelude::*;
 use umls_cli::builtin::BUILTIN;
 use umls_cli::scene::Scene;
-use umls_cli::setup::build;
-use umls_mesh::generate::{Diagonal, Lattice};
-use umls_mesh::{MeshError, SimplexMesh};
-
-fn split1(l: &Lattice<1>, _: Diagonal) -> Result<SimplexMesh<1>, MeshError> {
-    l.segments()
-}
-fn split2(l: &Lattice<2>, d: Diagonal) -> Result<SimplexMesh<2>, MeshError> {
-    l.triangles(d)
-}
-fn split3(l: &Lattice<3>, _: Diagonal) -> Result<SimplexMesh<3>, MeshError> {
-    l.tetrahedra()
-}
+use umls_cli::setup::{build, segments, tetrahedra, triangles};
 
 /// Byte ranges of the numeric literals of a scene text (outside comments and strings).
 fn numbers(text: &str) -> Vec<(usize, usize)> {
@@ -77,9 +65,9 @@ proptest! {
         if let Ok(scene) = Scene::parse(&text, "fuzz.toml", None) {
             // A scene whose dimension was changed builds for the dimension it claims.
             let _ = match scene.spec.scene.dimension {
-                1 => build::<1>(&scene, split1).map(|s| s.seeds.position.len()),
-                2 => build::<2>(&scene, split2).map(|s| s.seeds.position.len()),
-                3 => build::<3>(&scene, split3).map(|s| s.seeds.position.len()),
+                1 => build::<1>(&scene, segments).map(|s| s.seeds.position.len()),
+                2 => build::<2>(&scene, triangles).map(|s| s.seeds.position.len()),
+                3 => build::<3>(&scene, tetrahedra).map(|s| s.seeds.position.len()),
                 _ => Ok(0),
             };
         }

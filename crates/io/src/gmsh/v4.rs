@@ -61,6 +61,27 @@ fn dimension(c: &mut Cursor<'_>) -> Result<(usize, Position)> {
     }
 }
 
+/// The part of an entity record shared by `$Entities` and `$PartitionedEntities`:
+/// coordinates (X Y Z for points, a bounding box for higher entities), the physical
+/// tags, which are returned, and the bounding entities of curves, surfaces and volumes.
+fn entity_physical_tags(c: &mut Cursor<'_>, dim: usize) -> Result<Vec<i32>> {
+    let coordinates = if dim == 0 { 3 } else { 6 };
+    for _ in 0..coordinates {
+        double(c, "an entity coordinate")?;
+    }
+    let n_physical = count(c, "the number of physical tags", 4)?;
+    let tags = (0..n_physical)
+        .map(|_| int(c, "a physical tag"))
+        .collect::<Result<Vec<i32>>>()?;
+    if dim > 0 {
+        let n_bounding = count(c, "the number of bounding entities", 4)?;
+        for _ in 0..n_bounding {
+            int(c, "a bounding entity tag")?;
+        }
+    }
+    Ok(tags)
+}
+
 pub(crate) fn read_entities(c: &mut Cursor<'_>) -> Result<EntityPhysicals> {
     c.start_binary();
     let counts = [
@@ -73,22 +94,7 @@ pub(crate) fn read_entities(c: &mut Cursor<'_>) -> Result<EntityPhysicals> {
     for (dim, &n) in counts.iter().enumerate() {
         for _ in 0..n {
             let tag = int(c, "an entity tag")?;
-            // Points store X Y Z, higher entities a bounding box.
-            let coordinates = if dim == 0 { 3 } else { 6 };
-            for _ in 0..coordinates {
-                double(c, "an entity coordinate")?;
-            }
-            let n_physical = count(c, "the number of physical tags", 4)?;
-            let tags = (0..n_physical)
-                .map(|_| int(c, "a physical tag"))
-                .collect::<Result<Vec<i32>>>()?;
-            physicals.insert((dim, tag), tags);
-            if dim > 0 {
-                let n_bounding = count(c, "the number of bounding entities", 4)?;
-                for _ in 0..n_bounding {
-                    int(c, "a bounding entity tag")?;
-                }
-            }
+            physicals.insert((dim, tag), entity_physical_tags(c, dim)?);
         }
     }
     Ok(physicals)
@@ -120,21 +126,7 @@ pub(crate) fn read_partitioned_entities(c: &mut Cursor<'_>) -> Result<EntityPhys
             for _ in 0..partitions {
                 int(c, "a partition tag")?;
             }
-            let coordinates = if dim == 0 { 3 } else { 6 };
-            for _ in 0..coordinates {
-                double(c, "an entity coordinate")?;
-            }
-            let n_physical = count(c, "the number of physical tags", 4)?;
-            let tags = (0..n_physical)
-                .map(|_| int(c, "a physical tag"))
-                .collect::<Result<Vec<i32>>>()?;
-            physicals.insert((dim, tag), tags);
-            if dim > 0 {
-                let n_bounding = count(c, "the number of bounding entities", 4)?;
-                for _ in 0..n_bounding {
-                    int(c, "a bounding entity tag")?;
-                }
-            }
+            physicals.insert((dim, tag), entity_physical_tags(c, dim)?);
         }
     }
     Ok(physicals)
