@@ -11,8 +11,8 @@ use std::time::Instant;
 use nalgebra::SVector;
 use serde_json::json;
 use umls_engine::{
-    Apic, Diagnostics, Flip, Particles, Pic, Simulation, StepSettings, TransferScheme,
-    VelocityGradientAffine,
+    Apic, Diagnostics, Flip, Particles, Pic, Simulation, StepSettings, TimeStepControl,
+    TransferScheme, VelocityGradientAffine, Wall, WallKind,
 };
 use umls_io::csv::HistoryWriter;
 use umls_io::vtk::Encoding;
@@ -260,23 +260,10 @@ fn transfer_name(spec: &crate::schema::TransferSpec) -> String {
     }
 }
 
-/// Energy with the gravitational potential −Σ m g·x, so that gravity scenes conserve it too.
-fn total_energy<const D: usize>(
-    d: &Diagnostics<D>,
-    gravity: &SVector<f64, D>,
-    positions: &[SVector<f64, D>],
-    mass: &[f64],
-) -> (f64, f64) {
-    let potential: f64 = if gravity.norm() == 0.0 {
-        0.0
-    } else {
-        -positions
-            .iter()
-            .zip(mass)
-            .map(|(x, m)| m * gravity.dot(x))
-            .sum::<f64>()
-    };
-    (potential, d.total_energy() + potential)
+/// Energy with the potential of gravity and body forces (minus their work since the
+/// start), so that scenes under gravity conserve it too.
+fn total_energy<const D: usize>(d: &Diagnostics<D>) -> (f64, f64) {
+    (-d.external_work, d.energy_balance())
 }
 
 fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
@@ -300,36 +287,63 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     }
     let mut settings = StepSettings::new(1.0);
     settings.gravity = setup.gravity;
+    settings.gravity_ramp = setup.gravity_ramp;
     settings.stress_update = setup.stress_update;
+    settings.damping = setup.damping;
     let mut sim = Simulation::new(kernel, table, transfer, particles, settings)?;
+    if let Some(k0) = setup.geostatic_k0 {
+        sim.set_geostatic_stress(k0)?;
+    }
 
-    let target_dt = match (spec.time.dt, spec.time.cfl) {
-        (Some(dt), _) => dt,
-        (_, Some(cfl)) => sim.stable_time_step(cfl),
+    let mut warnings = Vec::new();
+    let stable_dt = sim.stable_time_step(1.0);
+    let target_dt = match (spec.time.dt, spec.time.cfl, spec.time.adaptive) {
+        (_, Some(cfl), true) => {
+            sim.settings.time_step = TimeStepControl::Adaptive { cfl };
+            spec.time
+                .dt
+                .unwrap_or(f64::INFINITY)
+                .min(sim.stable_time_step(cfl))
+        }
+        (Some(dt), _, _) => dt,
+        (_, Some(cfl), _) => sim.stable_time_step(cfl),
         _ => unreachable_dt(scene)?,
     };
     let steps = ((ctx.end_time / target_dt) - 1e-9).ceil().max(1.0) as usize;
-    sim.settings.dt = ctx.end_time / steps as f64;
+    let dt_cap = match sim.settings.time_step {
+        TimeStepControl::Adaptive { .. } => spec.time.dt.unwrap_or(ctx.end_time),
+        TimeStepControl::Fixed => ctx.end_time / steps as f64,
+    };
+    sim.settings.dt = dt_cap;
+    if sim.settings.time_step == TimeStepControl::Fixed && sim.settings.dt > stable_dt {
+        warnings.push(format!(
+            "time.dt = {:.4e} exceeds the stable step {stable_dt:.4e} (wave Courant number {:.3} > 1): expect the run to blow up",
+            sim.settings.dt,
+            sim.settings.dt / stable_dt
+        ));
+    }
 
     let mesh_kernel = matches!(ctx.kernel, KernelKind::Umls | KernelKind::LinearFe);
     for (i, (kind, target)) in setup.boundaries.iter().enumerate() {
+        let wall_kind = match kind {
+            BoundaryKind::Fixed => WallKind::Fixed,
+            BoundaryKind::Slip => WallKind::Slip,
+        };
         match target {
             BoundaryTarget::Plane { point, normal } => {
                 let tolerance = 1e-6 * sim.kernel.spacing();
-                let nodes =
-                    umls_engine::Boundary::nodes_on_plane(&sim.kernel, point, normal, tolerance);
-                if nodes.is_empty() {
+                let wall = Wall::facing(wall_kind, *point, *normal, &sim.particles.position)
+                    .ok_or_else(|| {
+                        scene.value_error(
+                            format!("boundaries[{i}].plane.normal"),
+                            "must not be zero",
+                        )
+                    })?;
+                if sim.boundary.add_wall(&sim.kernel, wall, tolerance) == 0 {
                     return Err(scene.value_error(
                         format!("boundaries[{i}].plane"),
-                        format!("no {} node lies on the plane", ctx.kernel.name()),
+                        format!("no {} node lies on or beyond the plane", ctx.kernel.name()),
                     ));
-                }
-                match kind {
-                    BoundaryKind::Fixed => sim.boundary.fixed.extend(nodes),
-                    BoundaryKind::Slip => sim
-                        .boundary
-                        .slip
-                        .extend(nodes.into_iter().map(|n| (n, *normal))),
                 }
             }
             BoundaryTarget::Vertices(vertices) => {
@@ -348,6 +362,9 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
             }
         }
     }
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
 
     let mut out = OutputDir::create(&ctx.options.out, ctx.encoding)?;
     let axes = ["x", "y", "z"];
@@ -356,7 +373,18 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         .map(|s| s.to_string())
         .collect();
     header.extend((0..D).map(|k| format!("momentum_{}", axes[k])));
-    header.extend(["mass", "max_speed", "courant"].map(String::from));
+    header.extend(
+        [
+            "mass",
+            "max_speed",
+            "courant",
+            "dt",
+            "wave_courant",
+            "dropped_mass",
+            "wall_corrections",
+        ]
+        .map(String::from),
+    );
     if setup.reference.is_some() {
         header.push("velocity_error".into());
     }
@@ -372,12 +400,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
                   error: Option<f64>|
      -> Result<(f64, Diagnostics<D>, EnergyRecord)> {
         let d = sim.diagnostics()?;
-        let (potential, total) = total_energy(
-            &d,
-            &setup.gravity,
-            &sim.particles.position,
-            &sim.particles.mass,
-        );
+        let (potential, total) = total_energy(&d);
         let mut row = vec![
             d.step as f64,
             d.time,
@@ -387,7 +410,15 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
             total,
         ];
         row.extend(d.momentum.iter());
-        row.extend([d.mass, d.max_speed, d.courant]);
+        row.extend([
+            d.mass,
+            d.max_speed,
+            d.courant,
+            d.dt,
+            d.wave_courant,
+            d.dropped_mass,
+            d.wall_corrections as f64,
+        ]);
         row.extend(error);
         history.row(&row)?;
         let record = EnergyRecord {
@@ -428,7 +459,13 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     let mut failure: Option<CliError> = None;
     let mut last = d0;
     let mut last_total = e0;
-    for step in 1..=steps {
+    let mut max_wave_courant = d0.wave_courant;
+    let mut step = 0;
+    while sim.time() < ctx.end_time * (1.0 - 1e-12) {
+        step += 1;
+        if let TimeStepControl::Adaptive { .. } = sim.settings.time_step {
+            sim.settings.dt = dt_cap.min(ctx.end_time - sim.time());
+        }
         if let Err(e) = sim.step() {
             failure = Some(e.into());
             break;
@@ -438,8 +475,10 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
             error_sum += e * e;
             error_max = error_max.max(e);
         }
-        if step % spec.output.history_every == 0 || step == steps {
+        let last_step = sim.time() >= ctx.end_time * (1.0 - 1e-12);
+        if step % spec.output.history_every == 0 || last_step {
             let (total, d, r) = record(&sim, &mut history, error)?;
+            max_wave_courant = max_wave_courant.max(d.wave_courant);
             energies.push(r);
             energy_change = energy_change.max((total - e0).abs());
             last_total = total;
@@ -490,6 +529,12 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         "momentum_change".into(),
         json!((last.momentum - d0.momentum).norm()),
     );
+    metrics.insert("dropped_mass".into(), json!(last.dropped_mass));
+    metrics.insert(
+        "dropped_momentum".into(),
+        json!(last.dropped_momentum.norm()),
+    );
+    metrics.insert("wall_corrections".into(), json!(last.wall_corrections));
     if setup.reference.is_some() && taken > 0 {
         metrics.insert(
             "velocity_rmse".into(),
@@ -508,7 +553,15 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         "particles": sim.particles.len(),
         "nodes": sim.kernel.node_count(),
         "cells": setup.mesh.simplex_count(),
-        "dt": sim.settings.dt,
+        "dt": sim.last_dt(),
+        "time_step": match sim.settings.time_step {
+            TimeStepControl::Fixed => "fixed",
+            TimeStepControl::Adaptive { .. } => "adaptive",
+        },
+        "stable_dt": stable_dt,
+        "dt_exceeds_stable": sim.settings.time_step == TimeStepControl::Fixed && sim.settings.dt > stable_dt,
+        "max_wave_courant": max_wave_courant,
+        "warnings": warnings,
         "end_time": ctx.end_time,
         "steps_planned": steps,
         "steps": taken,

@@ -31,6 +31,28 @@ pub struct SceneSpec {
     pub boundaries: Vec<BoundarySpec>,
     /// Analytic reference solution, if the scene has one.
     pub reference: Option<ReferenceSpec>,
+    /// Damping of the nodal forces (quasi-static runs).
+    pub damping: Option<DampingSpec>,
+    /// Initial stress of the particles.
+    pub initial_stress: Option<InitialStressSpec>,
+}
+
+/// `[damping]`: exactly one of `local` (Cundall's α) and `mass` (β in 1/s).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DampingSpec {
+    /// Local non-viscous damping coefficient α ∈ [0, 1).
+    pub local: Option<f64>,
+    /// Mass-proportional damping β ≥ 0 in 1/s.
+    pub mass: Option<f64>,
+}
+
+/// `[initial_stress]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialStressSpec {
+    /// Geostatic stress with this lateral ratio K0 = σ_h / σ_v (needs gravity).
+    pub geostatic_k0: f64,
 }
 
 /// `[scene]`.
@@ -48,6 +70,8 @@ pub struct SceneHeader {
     pub end_time: f64,
     /// Gravity vector (D components); zero if absent.
     pub gravity: Option<Vec<f64>>,
+    /// Time over which gravity grows linearly from zero to its full value.
+    pub gravity_ramp: Option<f64>,
 }
 
 /// `[mesh]`: exactly one of `file` and `lattice`.
@@ -172,6 +196,10 @@ pub struct TimeSpec {
     pub cfl: Option<f64>,
     /// "usl" (default) or "musl".
     pub stress_update: Option<String>,
+    /// Recompute Δt = cfl · h / (c + |v|_max) before every step (needs `cfl`; `dt`, if
+    /// also given, is the largest step).
+    #[serde(default)]
+    pub adaptive: bool,
 }
 
 /// `[output]`.

@@ -8,7 +8,7 @@ use umls_constitutive::{
     ConeFit, DruckerPrager, ElasticParameters, ElastoPlastic, FixedCorotated, LinearElastic,
     NeoHookean, StVenantKirchhoff, VonMises, WeaklyCompressibleFluid,
 };
-use umls_engine::{Region, StressUpdate, lattice_samples};
+use umls_engine::{Damping, Region, StressUpdate, lattice_samples};
 use umls_io::gmsh::{PhysicalGroup, ReadOptions, parse_msh};
 use umls_mesh::generate::{Diagonal, Lattice};
 use umls_mesh::{Orientation, SampleRule, SimplexMesh};
@@ -75,6 +75,12 @@ pub struct Setup<const D: usize> {
     pub gravity: SVector<f64, D>,
     /// USL or MUSL.
     pub stress_update: StressUpdate,
+    /// Gravity ramp time (0: none).
+    pub gravity_ramp: f64,
+    /// Damping of the nodal forces.
+    pub damping: Damping,
+    /// Geostatic K0, if the particles start with their geostatic stress.
+    pub geostatic_k0: Option<f64>,
     /// The analytic velocity v(X, t), and the scale its RMSE is divided by.
     pub reference: Option<(VectorField<D>, f64)>,
 }
@@ -481,7 +487,7 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
         };
         boundaries.push((b.kind, target));
     }
-    let gravity = match &spec.scene.gravity {
+    let gravity: SVector<f64, D> = match &spec.scene.gravity {
         None => SVector::zeros(),
         Some(g) => vector(scene, "scene.gravity", g)?,
     };
@@ -494,6 +500,40 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
                 format!("`{other}`: expected usl or musl"),
             ));
         }
+    };
+    let gravity_ramp = spec.scene.gravity_ramp.unwrap_or(0.0);
+    if !(gravity_ramp.is_finite() && gravity_ramp >= 0.0) {
+        return Err(scene.value_error("scene.gravity_ramp", "must be finite and non-negative"));
+    }
+    let damping = match &spec.damping {
+        None => Damping::None,
+        Some(d) => match (d.local, d.mass) {
+            (Some(alpha), None) if (0.0..1.0).contains(&alpha) => Damping::Local { alpha },
+            (Some(_), None) => return Err(scene.value_error("damping.local", "must lie in [0, 1)")),
+            (None, Some(beta)) if beta.is_finite() && beta >= 0.0 => {
+                Damping::MassProportional { beta }
+            }
+            (None, Some(_)) => {
+                return Err(scene.value_error("damping.mass", "must be finite and non-negative"));
+            }
+            _ => return Err(scene.value_error("damping", "give exactly one of `local` and `mass`")),
+        },
+    };
+    let geostatic_k0 = match &spec.initial_stress {
+        None => None,
+        Some(i) if !(i.geostatic_k0.is_finite() && i.geostatic_k0 >= 0.0) => {
+            return Err(scene.value_error(
+                "initial_stress.geostatic_k0",
+                "must be finite and non-negative",
+            ));
+        }
+        Some(_) if gravity.norm() == 0.0 => {
+            return Err(scene.value_error(
+                "initial_stress.geostatic_k0",
+                "a geostatic stress needs `scene.gravity`",
+            ));
+        }
+        Some(i) => Some(i.geostatic_k0),
     };
     let reference = match &spec.reference {
         None => None,
@@ -533,6 +573,9 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
         boundaries,
         gravity,
         stress_update,
+        gravity_ramp,
+        damping,
+        geostatic_k0,
         reference,
     })
 }
@@ -543,12 +586,27 @@ pub fn check_header(scene: &Scene) -> Result<()> {
     if !(spec.scene.end_time.is_finite() && spec.scene.end_time > 0.0) {
         return Err(scene.value_error("scene.end_time", "must be finite and positive"));
     }
-    match (spec.time.dt, spec.time.cfl) {
-        (Some(dt), None) if dt.is_finite() && dt > 0.0 => {}
-        (None, Some(cfl)) if cfl.is_finite() && cfl > 0.0 && cfl <= 1.0 => {}
-        (Some(_), None) => return Err(scene.value_error("time.dt", "must be finite and positive")),
-        (None, Some(_)) => return Err(scene.value_error("time.cfl", "must be in (0, 1]")),
-        _ => return Err(scene.value_error("time", "give exactly one of `dt` and `cfl`")),
+    let dt_ok = |dt: f64| dt.is_finite() && dt > 0.0;
+    let cfl_ok = |cfl: f64| cfl.is_finite() && cfl > 0.0 && cfl <= 1.0;
+    match (spec.time.dt, spec.time.cfl, spec.time.adaptive) {
+        (Some(dt), None, false) if dt_ok(dt) => {}
+        (None, Some(cfl), _) if cfl_ok(cfl) => {}
+        (Some(dt), Some(cfl), true) if dt_ok(dt) && cfl_ok(cfl) => {}
+        (Some(dt), _, _) if !dt_ok(dt) => {
+            return Err(scene.value_error("time.dt", "must be finite and positive"));
+        }
+        (_, Some(cfl), _) if !cfl_ok(cfl) => {
+            return Err(scene.value_error("time.cfl", "must be in (0, 1]"));
+        }
+        (_, None, true) => {
+            return Err(scene.value_error("time.adaptive", "an adaptive time step needs `cfl`"));
+        }
+        _ => {
+            return Err(scene.value_error(
+                "time",
+                "give exactly one of `dt` and `cfl` (both only with `adaptive = true`)",
+            ));
+        }
     }
     match (spec.output.frames, spec.output.interval) {
         (Some(_), Some(_)) => {

@@ -470,6 +470,118 @@ fn an_unstable_run_leaves_its_history_and_says_why() {
     assert!(s["error"].as_str().unwrap().contains("step"));
     let (_, rows) = history(&dir.join("out"));
     assert!(!rows.is_empty());
+    // The time step was 0.2 / 1e-3 = 200 times the one the scene is stable with: said
+    // before the run, and in the summary.
+    assert!(err.contains("warning: time.dt"), "{err}");
+    assert_eq!(s["dt_exceeds_stable"], true);
+}
+
+/// The quasi-static keys: a soft column on slip planes, loaded by a gravity ramp, damped,
+/// with an adaptive time step; and the same column started at its geostatic stress.
+#[test]
+fn quasi_static_column_keys() {
+    let column = |extra: &str, ramp: &str| {
+        format!(
+            r#"
+[scene]
+name = "column"
+dimension = 2
+end_time = 0.3
+gravity = [0.0, -10.0]
+{ramp}
+
+[mesh.lattice]
+lower = [0.0, 0.0]
+upper = [1.0, 2.2]
+cells = [10, 22]
+
+[kernel]
+kind = "bspline2"
+
+[transfer]
+kind = "pic"
+
+[time]
+cfl = 0.3
+adaptive = true
+
+[damping]
+local = 0.7
+
+[output]
+frames = 2
+
+[[materials]]
+name = "soil"
+model = "linear-elastic"
+density = 1000.0
+young = 1e6
+poisson = 0.3
+
+[[bodies]]
+material = "soil"
+region = {{ box = {{ lower = [0.0, 0.0], upper = [1.0, 2.0] }} }}
+seeding = {{ lattice = 0.05 }}
+
+[[boundaries]]
+kind = "slip"
+plane = {{ point = [0.0, 0.0], normal = [1.0, 0.0] }}
+
+[[boundaries]]
+kind = "slip"
+plane = {{ point = [1.0, 0.0], normal = [1.0, 0.0] }}
+
+[[boundaries]]
+kind = "slip"
+plane = {{ point = [0.0, 0.0], normal = [0.0, 1.0] }}
+{extra}
+"#
+        )
+    };
+    let dir = scratch("quasi-static");
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |name: &str, text: String| {
+        let file = dir.join(format!("{name}.toml"));
+        std::fs::write(&file, text).unwrap();
+        let out_dir = dir.join(name);
+        let out = umls(&[
+            "run",
+            file.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--quiet",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        (summary(&out_dir), history(&out_dir))
+    };
+    let (ramped, (header, rows)) = run("ramped", column("", "gravity_ramp = 0.1"));
+    assert_eq!(ramped["time_step"], "adaptive");
+    assert_eq!(ramped["dt_exceeds_stable"], false);
+    let column_of = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let (courant, potential) = (column_of("wave_courant"), column_of("potential"));
+    // Adaptive Δt keeps the wave Courant number at the requested 0.3 (the history's
+    // value uses the speeds after the step, Δt those before it).
+    assert!(
+        rows.iter().all(|r| r[courant] <= 0.3 * (1.0 + 1e-3)),
+        "{rows:?}"
+    );
+    // (The last step is shortened to end at end_time.)
+    assert!(rows[..rows.len() - 1].iter().all(|r| r[courant] >= 0.29));
+    // Gravity did work: the column settled (potential is minus that work).
+    assert!(rows.last().unwrap()[potential] < 0.0);
+    let (geostatic, (_, rows)) = run(
+        "geostatic",
+        column("[initial_stress]\ngeostatic_k0 = 0.4285714285714286\n", ""),
+    );
+    assert_eq!(geostatic["status"], "completed");
+    let speed = header.iter().position(|h| h == "max_speed").unwrap();
+    // Started at its weight's stress, the column barely moves; without it it falls
+    // at g t until the base stops it.
+    assert!(rows.iter().all(|r| r[speed] < 0.05), "{rows:?}");
 }
 
 /// Writes `text` as `name` in a fresh scratch directory whose `meshes/` holds the

@@ -51,19 +51,43 @@ pub enum EngineError {
         /// det F.
         det: f64,
     },
-    /// Total energy grew beyond the configured factor of its initial value.
+    /// Kinetic plus elastic energy grew beyond the configured factor of the energy put
+    /// into the body (initial energy plus the work of gravity and body forces).
     #[error(
-        "step {step}: total energy {energy:e} exceeds {factor} × the initial {initial:e} (instability)"
+        "step {step}: kinetic + elastic energy {energy:e} exceeds {factor} × the {initial:e} put in (initial energy plus work of gravity and body forces): unstable"
     )]
     EnergyBlowUp {
         /// Step number.
         step: usize,
-        /// Current total energy.
+        /// Current kinetic plus elastic energy.
         energy: f64,
-        /// Initial total energy.
+        /// Energy put in: the initial energy plus the largest external work so far.
         initial: f64,
         /// The configured factor.
         factor: f64,
+    },
+    /// A particle moved more than the allowed number of kernel spacings in one step: the
+    /// time step is too large for its speed (or the run has become unstable).
+    #[error(
+        "step {step}, particle {particle}: moved {courant:.3} kernel spacings in one step (limit {limit}): the time step is too large for its speed"
+    )]
+    Unstable {
+        /// Step number.
+        step: usize,
+        /// The fastest particle.
+        particle: usize,
+        /// Its Courant number |v| Δt / h.
+        courant: f64,
+        /// The configured limit.
+        limit: f64,
+    },
+    /// The initial stress could not be imposed on a particle.
+    #[error("particle {particle}: cannot impose the initial stress: {reason}")]
+    InitialStress {
+        /// Particle index.
+        particle: usize,
+        /// Why.
+        reason: &'static str,
     },
     /// A parameter out of range.
     #[error("parameter `{parameter}` = {value}: {reason}")]

@@ -40,15 +40,23 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod boundary;
+mod diagnostics;
 mod error;
+pub mod geostatic;
+mod grid;
 mod particles;
 mod seeding;
+mod settings;
 mod simulation;
 mod stencils;
 mod transfer;
 
+pub use boundary::{Boundary, Wall, WallKind};
+pub use diagnostics::Diagnostics;
 pub use error::EngineError;
 pub use particles::Particles;
 pub use seeding::{Inside, Region, lattice_samples};
-pub use simulation::{BodyForce, Boundary, Diagnostics, Simulation, StepSettings};
+pub use settings::{Damping, StepSettings, TimeStepControl};
+pub use simulation::{BodyForce, Simulation};
 pub use transfer::{Apic, Flip, Pic, StressUpdate, TransferScheme, VelocityGradientAffine};

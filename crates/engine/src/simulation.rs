@@ -6,142 +6,19 @@ use rayon::prelude::*;
 use umls_constitutive::Constitutive;
 use umls_transfer::Kernel;
 
+use crate::boundary::Boundary;
+use crate::diagnostics::{Diagnostics, Totals};
 use crate::error::EngineError;
+use crate::geostatic;
+use crate::grid::Grid;
 use crate::particles::Particles;
+use crate::settings::{Damping, StepSettings, TimeStepControl};
 use crate::stencils::Stencils;
 use crate::transfer::{StressUpdate, TransferScheme};
 
 /// A body acceleration field b(x, t), added to gravity.
 pub type BodyForce<const D: usize> =
     std::sync::Arc<dyn Fn(&SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync>;
-
-/// Velocity boundary conditions on grid nodes.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Boundary<const D: usize> {
-    /// Nodes whose velocity is zero.
-    pub fixed: Vec<u32>,
-    /// Nodes whose velocity loses its component along the given unit normal
-    /// (frictionless slip; only the outward, separating component is kept if
-    /// `separate` is set).
-    pub slip: Vec<(u32, SVector<f64, D>)>,
-    /// Whether slip nodes may move away from the wall (v·n > 0 kept).
-    pub separate: bool,
-}
-
-impl<const D: usize> Boundary<D> {
-    /// Nodes of `kernel` within `tolerance` of the plane through `point` with normal `normal`.
-    pub fn nodes_on_plane<K: Kernel<D>>(
-        kernel: &K,
-        point: &SVector<f64, D>,
-        normal: &SVector<f64, D>,
-        tolerance: f64,
-    ) -> Vec<u32> {
-        let unit = normal.normalize();
-        (0..kernel.node_count())
-            .filter(|&n| (kernel.node_position(n) - point).dot(&unit).abs() <= tolerance)
-            .map(|n| n as u32)
-            .collect()
-    }
-
-    /// Fixes every node on the plane (see [`Self::nodes_on_plane`]).
-    pub fn fix_plane<K: Kernel<D>>(
-        &mut self,
-        kernel: &K,
-        point: &SVector<f64, D>,
-        normal: &SVector<f64, D>,
-        tolerance: f64,
-    ) {
-        self.fixed
-            .extend(Self::nodes_on_plane(kernel, point, normal, tolerance));
-    }
-
-    /// Frictionless slip along the plane for every node on it, with the plane's unit normal.
-    pub fn slip_plane<K: Kernel<D>>(
-        &mut self,
-        kernel: &K,
-        point: &SVector<f64, D>,
-        normal: &SVector<f64, D>,
-        tolerance: f64,
-    ) {
-        let unit = normal.normalize();
-        self.slip.extend(
-            Self::nodes_on_plane(kernel, point, normal, tolerance)
-                .into_iter()
-                .map(|n| (n, unit)),
-        );
-    }
-
-    fn apply(&self, velocity: &mut [SVector<f64, D>]) {
-        for &node in &self.fixed {
-            velocity[node as usize] = SVector::zeros();
-        }
-        for (node, normal) in &self.slip {
-            let v = &mut velocity[*node as usize];
-            let vn = v.dot(normal);
-            if !self.separate || vn < 0.0 {
-                *v -= normal * vn;
-            }
-        }
-    }
-}
-
-/// Step settings.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StepSettings<const D: usize> {
-    /// Time step Δt.
-    pub dt: f64,
-    /// Body acceleration (gravity).
-    pub gravity: SVector<f64, D>,
-    /// Where the stress is updated.
-    pub stress_update: StressUpdate,
-    /// Stop with [`EngineError::EnergyBlowUp`] when the total energy exceeds this factor
-    /// times its initial value (checked when the initial energy is positive).
-    pub energy_growth_limit: f64,
-    /// Nodes with mass below this fraction of the largest nodal mass are treated as empty
-    /// (zero velocity): MLS shape functions can be negative or tiny at the edge of a stencil.
-    pub min_mass_fraction: f64,
-}
-
-impl<const D: usize> StepSettings<D> {
-    /// Time step `dt`, no gravity, USL, energy limit 10×, mass threshold 10⁻¹⁰.
-    pub fn new(dt: f64) -> Self {
-        Self {
-            dt,
-            gravity: SVector::zeros(),
-            stress_update: StressUpdate::Usl,
-            energy_growth_limit: 10.0,
-            min_mass_fraction: 1e-10,
-        }
-    }
-}
-
-/// Energies and momentum of the particles.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Diagnostics<const D: usize> {
-    /// Step number.
-    pub step: usize,
-    /// Time.
-    pub time: f64,
-    /// Σ ½ m |v|².
-    pub kinetic: f64,
-    /// Σ V⁰ ψ(F).
-    pub elastic: f64,
-    /// Σ m v.
-    pub momentum: SVector<f64, D>,
-    /// Σ m.
-    pub mass: f64,
-    /// max |v|.
-    pub max_speed: f64,
-    /// Courant number max|v| Δt / h.
-    pub courant: f64,
-}
-
-impl<const D: usize> Diagnostics<D> {
-    /// Kinetic plus elastic energy.
-    pub fn total_energy(&self) -> f64 {
-        self.kinetic + self.elastic
-    }
-}
 
 /// Particle blocks of the parallel P2G scatter: a fixed number, so that results do not
 /// depend on the thread count; more blocks than cores keeps the work balanced.
@@ -155,18 +32,22 @@ const P2G_PARALLEL_MIN: usize = 8192;
 #[derive(Default)]
 struct GridBuffer<const D: usize> {
     mass: Vec<f64>,
+    abs_mass: Vec<f64>,
     momentum: Vec<SVector<f64, D>>,
     force: Vec<SVector<f64, D>>,
+    stiffness: Vec<f64>,
 }
 
 impl<const D: usize> GridBuffer<D> {
     fn reset(&mut self, nodes: usize) {
-        self.mass.clear();
-        self.mass.resize(nodes, 0.0);
-        self.momentum.clear();
-        self.momentum.resize(nodes, SVector::zeros());
-        self.force.clear();
-        self.force.resize(nodes, SVector::zeros());
+        for field in [&mut self.mass, &mut self.abs_mass, &mut self.stiffness] {
+            field.clear();
+            field.resize(nodes, 0.0);
+        }
+        for field in [&mut self.momentum, &mut self.force] {
+            field.clear();
+            field.resize(nodes, SVector::zeros());
+        }
     }
 }
 
@@ -197,14 +78,90 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     pub body_force: Option<BodyForce<D>>,
     step: usize,
     time: f64,
-    initial_energy: Option<f64>,
+    dt: f64,
+    totals: Totals<D>,
     stencils: Stencils<D>,
     blocks: Vec<GridBuffer<D>>,
-    node_mass: Vec<f64>,
-    node_momentum: Vec<SVector<f64, D>>,
-    node_force: Vec<SVector<f64, D>>,
-    node_velocity: Vec<SVector<f64, D>>,
-    node_new_velocity: Vec<SVector<f64, D>>,
+    grid: Grid<D>,
+}
+
+/// Checks a number setting.
+fn check(
+    parameter: &'static str,
+    value: f64,
+    ok: bool,
+    reason: &'static str,
+) -> Result<(), EngineError> {
+    if ok && value.is_finite() {
+        Ok(())
+    } else {
+        Err(EngineError::InvalidParameter {
+            parameter,
+            value,
+            reason,
+        })
+    }
+}
+
+impl<const D: usize> StepSettings<D> {
+    fn validate(&self) -> Result<(), EngineError> {
+        check("dt", self.dt, self.dt > 0.0, "must be finite and positive")?;
+        check(
+            "gravity_ramp",
+            self.gravity_ramp,
+            self.gravity_ramp >= 0.0,
+            "must be finite and non-negative",
+        )?;
+        check(
+            "energy_growth_limit",
+            self.energy_growth_limit,
+            self.energy_growth_limit > 1.0,
+            "must be finite and above 1",
+        )?;
+        check(
+            "energy_check_interval",
+            self.energy_check_interval as f64,
+            self.energy_check_interval >= 1,
+            "must be at least 1",
+        )?;
+        check(
+            "max_courant",
+            self.max_courant,
+            self.max_courant > 0.0,
+            "must be finite and positive",
+        )?;
+        check(
+            "cancellation_fraction",
+            self.cancellation_fraction,
+            (0.0..1.0).contains(&self.cancellation_fraction),
+            "must lie in [0, 1)",
+        )?;
+        if self.gravity.iter().any(|g| !g.is_finite()) {
+            return Err(EngineError::InvalidParameter {
+                parameter: "gravity",
+                value: self.gravity.norm(),
+                reason: "must be finite",
+            });
+        }
+        if let TimeStepControl::Adaptive { cfl } = self.time_step {
+            check("cfl", cfl, cfl > 0.0, "must be finite and positive")?;
+        }
+        match self.damping {
+            Damping::None => Ok(()),
+            Damping::Local { alpha } => check(
+                "damping.alpha",
+                alpha,
+                (0.0..1.0).contains(&alpha),
+                "must lie in [0, 1)",
+            ),
+            Damping::MassProportional { beta } => check(
+                "damping.beta",
+                beta,
+                beta >= 0.0,
+                "must be finite and non-negative",
+            ),
+        }
+    }
 }
 
 impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
@@ -216,32 +173,24 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         particles: Particles<D, M::State, K::Cache>,
         settings: StepSettings<D>,
     ) -> Result<Self, EngineError> {
-        if !(settings.dt.is_finite() && settings.dt > 0.0) {
-            return Err(EngineError::InvalidParameter {
-                parameter: "dt",
-                value: settings.dt,
-                reason: "must be finite and positive",
-            });
-        }
+        settings.validate()?;
         let nodes = kernel.node_count();
+        let grid = Grid::new(nodes, particles.mass.iter().copied().fold(0.0, f64::max));
         Ok(Self {
             kernel,
             material,
             transfer,
             particles,
             boundary: Boundary::default(),
+            dt: settings.dt,
             settings,
             body_force: None,
             step: 0,
             time: 0.0,
-            initial_energy: None,
+            totals: Totals::default(),
             stencils: Stencils::default(),
             blocks: Vec::new(),
-            node_mass: vec![0.0; nodes],
-            node_momentum: vec![SVector::zeros(); nodes],
-            node_force: vec![SVector::zeros(); nodes],
-            node_velocity: vec![SVector::zeros(); nodes],
-            node_new_velocity: vec![SVector::zeros(); nodes],
+            grid,
         })
     }
 
@@ -255,22 +204,54 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         self.time
     }
 
-    /// The largest stable time step for CFL number `cfl`: cfl · h / c, with c the p-wave
-    /// speed at the smallest particle density.
+    /// The time step of the last step (the configured one before the first step).
+    pub fn last_dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// The last step's Δt, or before the first step the one it will take.
+    fn current_dt(&self, max_speed: f64, min_density: f64) -> f64 {
+        match (self.step, self.settings.time_step) {
+            (0, TimeStepControl::Fixed) => self.settings.dt,
+            (0, TimeStepControl::Adaptive { cfl }) => {
+                self.settings
+                    .dt
+                    .min(self.stable_step_from(cfl, max_speed, min_density))
+            }
+            _ => self.dt,
+        }
+    }
+
+    /// Largest particle speed and smallest particle density m / (V⁰ det F) now.
+    fn speed_and_density(&self) -> (f64, f64) {
+        let p = &self.particles;
+        (0..p.len())
+            .into_par_iter()
+            .map(|i| {
+                let j = umls_constitutive::determinant(&p.deformation[i]);
+                (p.velocity[i].norm(), p.mass[i] / (p.volume[i] * j))
+            })
+            .reduce(|| (0.0, f64::INFINITY), |a, b| (a.0.max(b.0), a.1.min(b.1)))
+    }
+
+    /// The explicit step bound cfl · h / (c + |v|_max) from a speed and a density.
+    fn stable_step_from(&self, cfl: f64, max_speed: f64, min_density: f64) -> f64 {
+        let c = self.material.p_wave_speed(min_density);
+        cfl * self.kernel.spacing() / (c + max_speed)
+    }
+
+    /// The stable time step for Courant number `cfl`: cfl · h / (c + |v|_max), with h the
+    /// kernel's effective spacing ([`Kernel::spacing`]), c the p-wave speed at the
+    /// smallest current particle density and |v|_max the fastest particle. The same
+    /// definition for every kernel; `cfl` = 1 is the stability limit.
     pub fn stable_time_step(&self, cfl: f64) -> f64 {
-        let density = self
-            .particles
-            .mass
-            .iter()
-            .zip(&self.particles.volume)
-            .map(|(m, v)| m / v)
-            .fold(f64::INFINITY, f64::min);
-        cfl * self.kernel.spacing() / self.material.p_wave_speed(density)
+        let (speed, density) = self.speed_and_density();
+        self.stable_step_from(cfl, speed, density)
     }
 
     /// Nodal masses and velocities of the last step (after the grid update).
     pub fn grid(&self) -> (&[f64], &[SVector<f64, D>]) {
-        (&self.node_mass, &self.node_new_velocity)
+        (&self.grid.mass, &self.grid.new_velocity)
     }
 
     /// Kirchhoff stress of every particle.
@@ -290,8 +271,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .collect()
     }
 
-    /// Energies, momentum and speed now.
-    pub fn diagnostics(&self) -> Result<Diagnostics<D>, EngineError> {
+    /// Σ V⁰ ψ(F) over the particles (in parallel, summed in particle order).
+    fn elastic_energy(&self) -> Result<f64, EngineError> {
         let p = &self.particles;
         let energies: Vec<f64> = (0..p.len())
             .into_par_iter()
@@ -299,43 +280,106 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 self.material
                     .energy_density(&p.deformation[i], &p.state[i])
                     .map(|psi| psi * p.volume[i])
+                    .map_err(|source| EngineError::Material {
+                        step: self.step,
+                        particle: i,
+                        source,
+                    })
             })
-            .collect::<Result<_, _>>()
-            .map_err(|source| EngineError::Material {
-                step: self.step,
-                particle: 0,
-                source,
-            })?;
-        // Serial sums: the same result for any thread count.
-        let elastic = energies.iter().sum();
+            .collect::<Result<_, _>>()?;
+        // Serial sum: the same result for any thread count.
+        Ok(energies.iter().sum())
+    }
+
+    /// Energies, momentum, speeds and Courant numbers now, with the run's totals.
+    pub fn diagnostics(&self) -> Result<Diagnostics<D>, EngineError> {
+        let p = &self.particles;
+        let elastic = self.elastic_energy()?;
         let mut kinetic = 0.0;
         let mut momentum = SVector::<f64, D>::zeros();
-        let mut max_speed: f64 = 0.0;
         for (m, v) in p.mass.iter().zip(&p.velocity) {
             kinetic += 0.5 * m * v.norm_squared();
             momentum += v * *m;
-            max_speed = max_speed.max(v.norm());
         }
+        let (max_speed, min_density) = self.speed_and_density();
+        let h = self.kernel.spacing();
+        let c = self.material.p_wave_speed(min_density);
+        let dt = self.current_dt(max_speed, min_density);
         Ok(Diagnostics {
             step: self.step,
             time: self.time,
+            dt,
             kinetic,
             elastic,
+            external_work: self.totals.external_work,
             momentum,
             mass: p.mass.iter().sum(),
             max_speed,
-            courant: max_speed * self.settings.dt / self.kernel.spacing(),
+            courant: max_speed * dt / h,
+            wave_courant: (c + max_speed) * dt / h,
+            dropped_mass: self.totals.dropped_mass,
+            dropped_momentum: self.totals.dropped_momentum,
+            wall_corrections: self.totals.wall_corrections,
         })
     }
 
-    /// One explicit step: locate and evaluate stencils, P2G, grid update with boundary
-    /// conditions, G2P, deformation and stress update, failure checks.
-    pub fn step(&mut self) -> Result<(), EngineError> {
-        let dt = self.settings.dt;
-        let step = self.step;
-        if self.initial_energy.is_none() {
-            self.initial_energy = Some(self.diagnostics()?.total_energy());
+    /// Sets every particle's stress to the geostatic state of a body at rest under
+    /// `settings.gravity`: σ_v = −ρ |g| d along gravity and `k0` σ_v across it, with d the
+    /// depth below the highest particle of the particle's vertical column (columns one
+    /// particle wide) plus half a particle. Imposed as an elastic pre-strain (see
+    /// [`geostatic::prestrain`]), so it works for every material. K0 = ν/(1 − ν) is the
+    /// elastic value under lateral confinement.
+    pub fn set_geostatic_stress(&mut self, k0: f64) -> Result<(), EngineError> {
+        check("k0", k0, k0 >= 0.0, "must be finite and non-negative")?;
+        let g = self.settings.gravity;
+        if g.norm() == 0.0 {
+            return Err(EngineError::InvalidParameter {
+                parameter: "gravity",
+                value: 0.0,
+                reason: "a geostatic stress needs gravity",
+            });
         }
+        let p = &self.particles;
+        let depths = geostatic::depths(&p.position, &p.volume, &g);
+        let material = &self.material;
+        let stretches: Vec<Result<SMatrix<f64, D, D>, EngineError>> = (0..p.len())
+            .into_par_iter()
+            .map(|i| {
+                let density = p.mass[i] / p.volume[i];
+                let target = geostatic::geostatic_stress(&g, density, depths[i], k0);
+                geostatic::prestrain(material, &p.state[i], &target).ok_or(
+                    EngineError::InitialStress {
+                        particle: i,
+                        reason: "the material cannot carry this stress (Newton's method did not converge)",
+                    },
+                )
+            })
+            .collect();
+        for (f, u) in self.particles.deformation.iter_mut().zip(stretches) {
+            *f = u?;
+        }
+        Ok(())
+    }
+
+    /// One explicit step: locate and evaluate stencils, P2G, grid update with boundary
+    /// conditions, G2P, walls, deformation and stress update, failure checks.
+    pub fn step(&mut self) -> Result<(), EngineError> {
+        let step = self.step;
+        if self.totals.initial_energy.is_none() {
+            let start = self.diagnostics()?;
+            self.totals.initial_energy = Some(start.total_energy());
+            self.totals.energy_supplied = start.total_energy();
+            (self.totals.max_speed, self.totals.min_density) = self.speed_and_density();
+        }
+        let dt = match self.settings.time_step {
+            TimeStepControl::Fixed => self.settings.dt,
+            TimeStepControl::Adaptive { cfl } => self.settings.dt.min(self.stable_step_from(
+                cfl,
+                self.totals.max_speed,
+                self.totals.min_density,
+            )),
+        };
+        self.dt = dt;
         // 1. Stencils.
         self.stencils
             .compute(
@@ -348,13 +392,57 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 particle,
                 source,
             })?;
-        // 2. P2G. Stresses in parallel, then the scatter in P2G_BLOCKS fixed particle blocks,
-        // each into its own grid buffer, in parallel; buffers are summed per node in block
-        // order. The split does not depend on the thread count, so neither do the sums.
+        // 2. P2G.
+        self.particles_to_grid()?;
+        // 3. Grid update.
+        let report = self.grid.update(
+            dt,
+            self.material.p_wave_modulus(),
+            self.settings.cancellation_fraction,
+            self.settings.damping,
+            &self.boundary,
+        );
+        self.totals.dropped_mass += report.dropped_mass;
+        self.totals.dropped_momentum += report.dropped_momentum;
+        if let Some(node) = self
+            .grid
+            .new_velocity
+            .iter()
+            .chain(&self.grid.gradient_velocity)
+            .position(|v| !v.iter().all(|c| c.is_finite()))
+        {
+            return Err(EngineError::NonFinite {
+                step,
+                field: "velocity",
+                entity: "node",
+                index: node % self.grid.mass.len(),
+            });
+        }
+        // 4. G2P and walls.
+        let mut velocity_gradients = self.grid_to_particles(dt);
+        if self.settings.stress_update == StressUpdate::Musl {
+            velocity_gradients = self.musl_velocity_gradients();
+        }
+        // 5. Deformation and stress update.
+        let min_density = self.update_deformation(&velocity_gradients, dt)?;
+        self.step += 1;
+        self.time += dt;
+        // 6. Failure detection.
+        self.check_particles(step, dt, min_density)?;
+        if self.step % self.settings.energy_check_interval == 0 {
+            self.check_energy(step)?;
+        }
+        Ok(())
+    }
+
+    /// P2G: stresses in parallel, then the scatter in P2G_BLOCKS fixed particle blocks,
+    /// each into its own grid buffer, in parallel; buffers are summed per node in block
+    /// order. The split does not depend on the thread count, so neither do the sums.
+    fn particles_to_grid(&mut self) -> Result<(), EngineError> {
         let stresses = self.stresses()?;
         let p = &self.particles;
-        let (stencils, kernel, settings, time) =
-            (&self.stencils, &self.kernel, &self.settings, self.time);
+        let (stencils, kernel, time) = (&self.stencils, &self.kernel, self.time);
+        let gravity = self.settings.gravity_at(time);
         let body_force = self.body_force.as_ref();
         let block_count = if p.len() < P2G_PARALLEL_MIN {
             1
@@ -362,7 +450,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             P2G_BLOCKS
         };
         let block_len = p.len().div_ceil(block_count).max(1);
-        let nodes = self.node_mass.len();
+        let nodes = self.grid.mass.len();
         self.blocks.resize_with(block_count, GridBuffer::default);
         self.blocks
             .par_iter_mut()
@@ -373,69 +461,60 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 let start = (block * block_len).min(end);
                 for (i, stress) in stresses.iter().enumerate().take(end).skip(start) {
                     let (m, v, c, x) = (p.mass[i], p.velocity[i], p.affine[i], p.position[i]);
-                    let stress_volume = stress * p.volume[i];
+                    let volume = p.volume[i];
+                    let stress_volume = stress * volume;
                     let acceleration =
-                        settings.gravity + body_force.map_or(SVector::zeros(), |b| b(&x, time));
+                        gravity + body_force.map_or(SVector::zeros(), |b| b(&x, time));
                     for e in stencils.range(i) {
                         let node = stencils.nodes[e] as usize;
                         let n = stencils.values[e];
+                        let gradient = stencils.gradients[e];
                         buffer.mass[node] += n * m;
+                        buffer.abs_mass[node] += n.abs() * m;
+                        buffer.stiffness[node] += volume * gradient.norm_squared();
                         let mut mv = v;
                         if T::AFFINE {
                             mv += c * (kernel.node_position(node) - x);
                         }
                         buffer.momentum[node] += mv * (n * m);
-                        buffer.force[node] +=
-                            acceleration * (n * m) - stress_volume * stencils.gradients[e];
+                        buffer.force[node] += acceleration * (n * m) - stress_volume * gradient;
                     }
                 }
             });
         let blocks = &self.blocks;
-        self.node_mass
+        let g = &mut self.grid;
+        g.mass
             .par_iter_mut()
-            .zip(self.node_momentum.par_iter_mut())
-            .zip(self.node_force.par_iter_mut())
+            .zip(g.abs_mass.par_iter_mut())
+            .zip(g.stiffness.par_iter_mut())
+            .zip(g.momentum.par_iter_mut())
+            .zip(g.force.par_iter_mut())
             .enumerate()
-            .for_each(|(node, ((mass, momentum), force))| {
-                *mass = blocks.iter().map(|b| b.mass[node]).sum();
-                *momentum = blocks
-                    .iter()
-                    .fold(SVector::zeros(), |acc, b| acc + b.momentum[node]);
-                *force = blocks
-                    .iter()
-                    .fold(SVector::zeros(), |acc, b| acc + b.force[node]);
-            });
-        // 3. Grid update.
-        let threshold =
-            self.settings.min_mass_fraction * self.node_mass.iter().copied().fold(0.0, f64::max);
-        for node in 0..self.node_mass.len() {
-            let m = self.node_mass[node];
-            if m > threshold {
-                self.node_velocity[node] = self.node_momentum[node] / m;
-                self.node_new_velocity[node] =
-                    self.node_velocity[node] + self.node_force[node] * (dt / m);
-            } else {
-                self.node_velocity[node] = SVector::zeros();
-                self.node_new_velocity[node] = SVector::zeros();
-            }
-        }
-        self.boundary.apply(&mut self.node_velocity);
-        self.boundary.apply(&mut self.node_new_velocity);
-        if let Some(node) = self
-            .node_new_velocity
-            .iter()
-            .position(|v| !v.iter().all(|c| c.is_finite()))
-        {
-            return Err(EngineError::NonFinite {
-                step,
-                field: "velocity",
-                entity: "node",
-                index: node,
-            });
-        }
-        // 4. G2P: velocity, affine matrix, position, velocity gradient.
+            .for_each(
+                |(node, ((((mass, abs_mass), stiffness), momentum), force))| {
+                    *mass = blocks.iter().map(|b| b.mass[node]).sum();
+                    *abs_mass = blocks.iter().map(|b| b.abs_mass[node]).sum();
+                    *stiffness = blocks.iter().map(|b| b.stiffness[node]).sum();
+                    *momentum = blocks
+                        .iter()
+                        .fold(SVector::zeros(), |acc, b| acc + b.momentum[node]);
+                    *force = blocks
+                        .iter()
+                        .fold(SVector::zeros(), |acc, b| acc + b.force[node]);
+                },
+            );
+        Ok(())
+    }
+
+    /// G2P: velocity, affine matrix, position, velocity gradient; then the walls. Returns
+    /// the velocity gradients (from the mass-scaled grid velocities, see `grid.rs`).
+    fn grid_to_particles(&mut self, dt: f64) -> Vec<SMatrix<f64, D, D>> {
         let (kernel, transfer, stencils) = (&self.kernel, self.transfer, &self.stencils);
-        let (old_v, new_v) = (&self.node_velocity, &self.node_new_velocity);
+        let (old_v, new_v, grad_source) = (
+            &self.grid.velocity,
+            &self.grid.new_velocity,
+            &self.grid.gradient_velocity,
+        );
         let positions = &self.particles.position;
         let velocities = &self.particles.velocity;
         let updates: Vec<ParticleUpdate<D>> = (0..self.particles.len())
@@ -453,10 +532,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     let n = stencils.values[e];
                     pic += new_v[node] * n;
                     flip += (new_v[node] - old_v[node]) * n;
-                    grad_v += new_v[node] * stencils.gradients[e].transpose();
+                    grad_v += grad_source[node] * stencils.gradients[e].transpose();
                     if T::USES_MOMENTS {
                         let r = kernel.node_position(node) - x;
-                        b += new_v[node] * r.transpose() * n;
+                        b += grad_source[node] * r.transpose() * n;
                         d += r * r.transpose() * n;
                     }
                 }
@@ -469,61 +548,94 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             })
             .collect();
         let mut velocity_gradients = Vec::with_capacity(updates.len());
+        let p = &mut self.particles;
+        let gravity = self.settings.gravity_at(self.time);
+        let body_force = self.body_force.as_ref();
+        // Work of gravity and body forces with the mean of old and new velocity: the
+        // trapezoidal rule balances the kinetic energy of a free fall exactly.
+        let mut power = 0.0;
         for (i, update) in updates.into_iter().enumerate() {
-            self.particles.velocity[i] = update.velocity;
-            self.particles.position[i] = update.position;
-            self.particles.affine[i] = update.affine;
+            let acceleration =
+                body_force.map_or(gravity, |b| gravity + b(&p.position[i], self.time));
+            power += p.mass[i] * acceleration.dot(&(p.velocity[i] + update.velocity)) * 0.5;
+            p.velocity[i] = update.velocity;
+            p.position[i] = update.position;
+            p.affine[i] = update.affine;
+            if self.boundary.hold(&mut p.position[i], &mut p.velocity[i]) {
+                self.totals.wall_corrections += 1;
+            }
             velocity_gradients.push(update.velocity_gradient);
         }
-        if self.settings.stress_update == StressUpdate::Musl {
-            velocity_gradients = self.musl_velocity_gradients(threshold);
-        }
-        // 5. Deformation and stress update.
+        self.totals.external_work += power * dt;
+        velocity_gradients
+    }
+
+    /// F ← (I + Δt ∇v) F and the return map; the smallest density m / (V⁰ det F).
+    fn update_deformation(
+        &mut self,
+        velocity_gradients: &[SMatrix<f64, D, D>],
+        dt: f64,
+    ) -> Result<f64, EngineError> {
+        let step = self.step;
         let material = &self.material;
-        let results: Vec<Result<(), EngineError>> = self
-            .particles
-            .deformation
+        let p = &mut self.particles;
+        let (mass, volume) = (&p.mass, &p.volume);
+        p.deformation
             .par_iter_mut()
-            .zip(self.particles.state.par_iter_mut())
+            .zip(p.state.par_iter_mut())
             .zip(velocity_gradients.par_iter())
             .enumerate()
             .map(|(i, ((f, state), gv))| {
+                let fail = |e| (i, e);
                 *f = (SMatrix::<f64, D, D>::identity() + gv * dt) * *f;
                 if !f.iter().all(|c| c.is_finite()) {
-                    return Err(EngineError::NonFinite {
+                    return Err(fail(EngineError::NonFinite {
                         step,
                         field: "deformation gradient",
                         entity: "particle",
                         index: i,
-                    });
+                    }));
                 }
                 let det = umls_constitutive::determinant(f);
                 if det <= 0.0 {
-                    return Err(EngineError::Inverted {
+                    return Err(fail(EngineError::Inverted {
                         step,
                         particle: i,
                         det,
-                    });
+                    }));
                 }
-                material
-                    .return_map(f, state)
-                    .map_err(|source| EngineError::Material {
+                material.return_map(f, state).map_err(|source| {
+                    fail(EngineError::Material {
                         step,
                         particle: i,
                         source,
                     })
+                })?;
+                Ok(mass[i] / (volume[i] * det))
             })
-            .collect();
-        results.into_iter().collect::<Result<Vec<()>, _>>()?;
-        self.step += 1;
-        self.time += dt;
-        // 6. Failure detection.
-        if let Some(i) = self
-            .particles
-            .velocity
-            .iter()
-            .zip(&self.particles.position)
-            .position(|(v, x)| !(v.iter().chain(x.iter()).all(|c| c.is_finite())))
+            // Among failures the lowest particle index wins, so the report does not
+            // depend on the thread count.
+            .reduce(
+                || Ok(f64::INFINITY),
+                |a, b| match (a, b) {
+                    (Ok(x), Ok(y)) => Ok(x.min(y)),
+                    (Err(e), Ok(_)) | (Ok(_), Err(e)) => Err(e),
+                    (Err(e1), Err(e2)) => Err(if e1.0 <= e2.0 { e1 } else { e2 }),
+                },
+            )
+            .map_err(|(_, e)| e)
+    }
+
+    /// NaN and Courant checks after a step; records speed and density for the next Δt.
+    fn check_particles(
+        &mut self,
+        step: usize,
+        dt: f64,
+        min_density: f64,
+    ) -> Result<(), EngineError> {
+        let p = &self.particles;
+        if let Some(i) = (0..p.len())
+            .find(|&i| !(p.velocity[i].iter().chain(p.position[i].iter())).all(|c| c.is_finite()))
         {
             return Err(EngineError::NonFinite {
                 step,
@@ -532,43 +644,75 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 index: i,
             });
         }
-        if let Some(initial) = self.initial_energy.filter(|e| *e > 0.0) {
-            let energy = self.diagnostics()?.total_energy();
-            if energy > self.settings.energy_growth_limit * initial {
-                return Err(EngineError::EnergyBlowUp {
-                    step,
-                    energy,
-                    initial,
-                    factor: self.settings.energy_growth_limit,
-                });
-            }
+        // The fastest particle, the first one among equals.
+        let (fastest, max_speed) = p
+            .velocity
+            .iter()
+            .map(|v| v.norm_squared())
+            .enumerate()
+            .fold((0, 0.0), |a, (i, s)| if s > a.1 { (i, s) } else { a });
+        let max_speed = max_speed.max(0.0).sqrt();
+        let courant = max_speed * dt / self.kernel.spacing();
+        if courant > self.settings.max_courant {
+            return Err(EngineError::Unstable {
+                step,
+                particle: fastest,
+                courant,
+                limit: self.settings.max_courant,
+            });
+        }
+        self.totals.max_speed = max_speed;
+        self.totals.min_density = min_density;
+        Ok(())
+    }
+
+    /// The energy check: kinetic + elastic energy against what was put in.
+    fn check_energy(&mut self, step: usize) -> Result<(), EngineError> {
+        let p = &self.particles;
+        let kinetic: f64 = p
+            .mass
+            .iter()
+            .zip(&p.velocity)
+            .map(|(m, v)| 0.5 * m * v.norm_squared())
+            .sum();
+        let energy = kinetic + self.elastic_energy()?;
+        let initial = self.totals.initial_energy.unwrap_or(0.0);
+        let t = &mut self.totals;
+        t.energy_supplied = t.energy_supplied.max(initial + t.external_work);
+        if t.energy_supplied > 0.0 && energy > self.settings.energy_growth_limit * t.energy_supplied
+        {
+            return Err(EngineError::EnergyBlowUp {
+                step,
+                energy,
+                initial: t.energy_supplied,
+                factor: self.settings.energy_growth_limit,
+            });
         }
         Ok(())
     }
 
     /// MUSL: re-map the updated particle momenta to the grid and take the velocity
     /// gradient of that grid velocity (stencils of the start of the step).
-    fn musl_velocity_gradients(&mut self, threshold: f64) -> Vec<SMatrix<f64, D, D>> {
-        self.node_momentum
-            .iter_mut()
-            .for_each(|m| *m = SVector::zeros());
+    fn musl_velocity_gradients(&mut self) -> Vec<SMatrix<f64, D, D>> {
+        let g = &mut self.grid;
+        g.momentum.iter_mut().for_each(|m| *m = SVector::zeros());
         let p = &self.particles;
         for i in 0..p.len() {
             for e in self.stencils.range(i) {
                 let node = self.stencils.nodes[e] as usize;
-                self.node_momentum[node] += p.velocity[i] * (self.stencils.values[e] * p.mass[i]);
+                g.momentum[node] += p.velocity[i] * (self.stencils.values[e] * p.mass[i]);
             }
         }
-        for node in 0..self.node_mass.len() {
-            let m = self.node_mass[node];
-            self.node_velocity[node] = if m > threshold {
-                self.node_momentum[node] / m
+        let fraction = self.settings.cancellation_fraction;
+        for node in 0..g.mass.len() {
+            g.velocity[node] = if g.is_active(node, fraction) {
+                g.momentum[node] / g.mass[node]
             } else {
                 SVector::zeros()
             };
         }
-        self.boundary.apply(&mut self.node_velocity);
-        let (stencils, v) = (&self.stencils, &self.node_velocity);
+        self.boundary.apply(&mut g.velocity);
+        let (stencils, v) = (&self.stencils, &g.velocity);
         (0..p.len())
             .into_par_iter()
             .map(|i| {

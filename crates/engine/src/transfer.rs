@@ -55,9 +55,11 @@ pub struct Flip {
 /// stencil so the scheme holds for any kernel (D_p is not the B-spline closed form).
 ///
 /// For hat functions D_p vanishes as a particle approaches a vertex (all weight on one
-/// node), and B_p D_p⁻¹ would explode; where D_p is ill-conditioned
-/// (det D_p < 10⁻⁶ (tr D_p / D)^D) the scheme uses the velocity gradient, which is what
-/// B_p D_p⁻¹ tends to for linear shape functions.
+/// node), and B_p D_p⁻¹ would explode; where D_p is not positive definite (Cholesky
+/// fails: MLS values can be negative, so D_p can have negative eigenvalues with a
+/// positive determinant) or is ill-conditioned (det D_p < 10⁻⁶ (tr D_p / D)^D) the scheme
+/// uses the velocity gradient, which B_p D_p⁻¹ equals for linear shape functions
+/// (N_i D_p⁻¹ (x_i − x_p) = ∇N_i on a simplex).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Apic;
 
@@ -100,12 +102,15 @@ impl TransferScheme for Apic {
         d: &SMatrix<f64, D, D>,
         grad_v: &SMatrix<f64, D, D>,
     ) -> SMatrix<f64, D, D> {
+        let Some(cholesky) = d.cholesky() else {
+            return *grad_v;
+        };
         let scale = (d.trace() / D as f64).powi(D as i32);
-        let det = umls_constitutive::determinant(d);
+        let det = cholesky.l_dirty().diagonal().product().powi(2);
         if det.is_nan() || det <= 1e-6 * scale {
             return *grad_v;
         }
-        d.try_inverse().map_or(*grad_v, |inv| b * inv)
+        b * cholesky.inverse()
     }
 }
 
@@ -156,6 +161,15 @@ mod tests {
         assert!((Apic.affine(&b, &d, &grad_v) - a).norm() < 1e-12);
         // All weight on one node: D = 0 → the velocity gradient, not an explosion.
         assert_eq!(Apic.affine(&b, &Matrix2::zeros(), &grad_v), grad_v);
+        // Positive determinant, two negative eigenvalues (possible with negative MLS
+        // values): not a moment matrix, so the velocity gradient.
+        let negative = nalgebra::Matrix3::new(-1.0, 0.0, 0.0, 0.0, -2.0, 0.0, 0.0, 0.0, 3.0);
+        assert!(umls_constitutive::determinant(&negative) > 0.0);
+        let g3 = nalgebra::Matrix3::from_element(7.0);
+        assert_eq!(
+            Apic.affine(&nalgebra::Matrix3::identity(), &negative, &g3),
+            g3
+        );
         assert_eq!(Pic.affine(&b, &d, &grad_v), Matrix2::zeros());
         assert_eq!(VelocityGradientAffine.affine(&b, &d, &grad_v), grad_v);
         let v = Flip { alpha: 0.75 }.velocity(

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use nalgebra::{Rotation2, Vector2};
 use umls_constitutive::{ElasticParameters, NeoHookean};
-use umls_engine::{Particles, Pic, Simulation, StepSettings};
+use umls_engine::{Particles, Pic, Simulation, StepSettings, Wall, WallKind};
 use umls_kernels::{HostCache, LinearFeKernel, Umls2};
 use umls_mesh::SimplexMesh;
 use umls_mesh::generate::{Diagonal, Lattice};
@@ -191,25 +191,33 @@ fn conditions_on_planes() {
         1e-9,
     );
     assert_eq!(bottom, vec![0, 1, 2, 3, 4]);
+    // Walls: oriented away from the material, they take the nodes on and beyond them.
+    let material = [Vector2::new(0.5, 0.5)];
+    let left = Wall::facing(
+        WallKind::Fixed,
+        Vector2::new(0.0, 0.0),
+        Vector2::new(3.0, 0.0),
+        &material,
+    )
+    .unwrap();
+    assert_eq!(left.normal, Vector2::new(-1.0, 0.0));
+    let top = Wall::facing(
+        WallKind::Slip,
+        Vector2::new(1.0, 0.75),
+        Vector2::new(0.0, -2.0),
+        &material,
+    )
+    .unwrap();
+    assert_eq!(top.normal, Vector2::new(0.0, 1.0));
     let mut boundary = umls_engine::Boundary::<2>::default();
-    boundary.fix_plane(
-        &kernel,
-        &Vector2::new(0.0, 0.0),
-        &Vector2::new(-1.0, 0.0),
-        1e-9,
-    );
-    boundary.slip_plane(
-        &kernel,
-        &Vector2::new(1.0, 1.0),
-        &Vector2::new(0.0, 2.0),
-        1e-9,
-    );
+    assert_eq!(boundary.add_wall(&kernel, left, 1e-9), 5);
+    assert_eq!(boundary.add_wall(&kernel, top, 1e-9), 10);
     assert_eq!(boundary.fixed, vec![0, 5, 10, 15, 20]);
-    assert_eq!(boundary.slip.len(), 5);
+    assert_eq!(boundary.slip.len(), 10);
     assert!(
         boundary
             .slip
             .iter()
-            .all(|(n, normal)| *n >= 20 && *normal == Vector2::new(0.0, 1.0))
+            .all(|(n, normal)| *n >= 15 && *normal == Vector2::new(0.0, 1.0))
     );
 }

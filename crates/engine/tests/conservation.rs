@@ -134,7 +134,7 @@ fn leaving_the_mesh_names_the_particle() {
     particles
         .velocity
         .iter_mut()
-        .for_each(|v| *v = Vector2::new(50.0, 0.0));
+        .for_each(|v| *v = Vector2::new(10.0, 0.0));
     let mut sim = Simulation::new(
         LinearFeKernel::new(mesh()),
         material,

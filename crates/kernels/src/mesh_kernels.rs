@@ -18,8 +18,10 @@ macro_rules! mesh_nodes {
             *self.mesh.vertex(node)
         }
 
+        /// The shortest simplex height: P1 elements' explicit stability limit scales with
+        /// it (a right triangle of legs h has height h/√2 across its hypotenuse).
         fn spacing(&self) -> f64 {
-            self.mesh.min_edge_length()
+            self.mesh.min_height()
         }
     };
 }

@@ -48,6 +48,7 @@ pub struct SimplexMesh<const D: usize> {
     pub(crate) index: SpatialIndex,
     pub(crate) max_edge: f64,
     pub(crate) min_edge: f64,
+    pub(crate) min_height: f64,
 }
 
 impl<const D: usize> SimplexMesh<D> {
@@ -163,7 +164,11 @@ impl<const D: usize> SimplexMesh<D> {
             index: SpatialIndex::Empty,
             max_edge,
             min_edge,
+            min_height: 0.0,
         };
+        mesh.min_height = (0..mesh.simplex_count())
+            .map(|s| mesh.height(s))
+            .fold(f64::INFINITY, f64::min);
         mesh.index = SpatialIndex::build(&mesh)?;
         Ok(mesh)
     }
@@ -256,6 +261,24 @@ impl<const D: usize> SimplexMesh<D> {
     /// Shortest edge in the mesh.
     pub fn min_edge_length(&self) -> f64 {
         self.min_edge
+    }
+
+    /// Shortest height (vertex-to-opposite-facet distance) of simplex `s`: 1 / max‖∇λ_n‖.
+    /// The explicit stability limit of P1 elements scales with it, not with the
+    /// shortest edge (a flat triangle has long edges and a short height).
+    pub fn height(&self, s: usize) -> f64 {
+        let largest = self
+            .barycentric_gradients(s)
+            .as_slice()
+            .iter()
+            .map(|g| g.norm())
+            .fold(0.0, f64::max);
+        1.0 / largest
+    }
+
+    /// Shortest simplex height in the mesh (see [`Self::height`]).
+    pub fn min_height(&self) -> f64 {
+        self.min_height
     }
 
     /// Barycentric coordinates of `x` with respect to simplex `s` (any point, inside or not).

@@ -61,7 +61,9 @@ pub trait Kernel<const D: usize>: Send + Sync {
     /// Position of node `node`.
     fn node_position(&self, node: usize) -> SVector<f64, D>;
 
-    /// Characteristic node spacing h (shortest edge, or grid spacing), for the CFL bound.
+    /// The effective node spacing h of the explicit stability limit: the stable time step
+    /// of every kernel is Δt = C · h / (c + |v|_max) with the p-wave speed c (the
+    /// grid spacing for grid kernels, the shortest simplex height for mesh kernels).
     fn spacing(&self) -> f64;
 
     /// Fills `out` with the stencil at `x`, using and updating `cache`.

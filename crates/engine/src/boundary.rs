@@ -1,0 +1,162 @@
+//! Velocity boundary conditions: node sets (fixed, slip) and planar walls.
+//!
+//! A wall acts twice. On the grid it constrains every node on or beyond its plane (the
+//! side away from the material): for B-splines those are the node layers outside the
+//! wall that the stencils of particles near the wall still reach, so the wall holds
+//! without ghost layers written by hand. On the particles it is a non-penetration
+//! constraint: a particle that G2P carried across the plane is put back on it and loses
+//! its outward normal velocity (and, at a fixed wall, its whole velocity). Kernels that
+//! do not interpolate (UMLS, B-splines) have a non-zero velocity at the wall even when
+//! every wall node is at rest, so the grid condition alone lets particles through.
+
+use nalgebra::SVector;
+use umls_transfer::Kernel;
+
+/// What a wall does to the velocity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WallKind {
+    /// No-slip: zero velocity.
+    Fixed,
+    /// Frictionless slip: zero normal velocity, tangential velocity free.
+    Slip,
+}
+
+/// A planar wall: the plane through `point` with unit `normal` pointing out of the
+/// material (into the wall).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Wall<const D: usize> {
+    /// Fixed or slip.
+    pub kind: WallKind,
+    /// A point on the plane.
+    pub point: SVector<f64, D>,
+    /// Unit normal pointing away from the material.
+    pub normal: SVector<f64, D>,
+}
+
+impl<const D: usize> Wall<D> {
+    /// A wall on the plane through `point` with normal ±`normal`, oriented so that it
+    /// points away from the majority of `material` points (the particles it holds).
+    /// `None` for a zero or non-finite normal.
+    pub fn facing(
+        kind: WallKind,
+        point: SVector<f64, D>,
+        normal: SVector<f64, D>,
+        material: &[SVector<f64, D>],
+    ) -> Option<Self> {
+        let length = normal.norm();
+        if !(length.is_finite() && length > 0.0) {
+            return None;
+        }
+        let mut unit = normal / length;
+        let beyond = material
+            .iter()
+            .filter(|x| (*x - point).dot(&unit) > 0.0)
+            .count();
+        if 2 * beyond > material.len() {
+            unit = -unit;
+        }
+        Some(Self {
+            kind,
+            point,
+            normal: unit,
+        })
+    }
+
+    /// Signed distance of `x` from the plane, positive beyond the wall.
+    #[inline]
+    pub fn distance(&self, x: &SVector<f64, D>) -> f64 {
+        (x - self.point).dot(&self.normal)
+    }
+}
+
+/// Velocity boundary conditions on grid nodes and walls for the particles.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Boundary<const D: usize> {
+    /// Nodes whose velocity is zero.
+    pub fixed: Vec<u32>,
+    /// Nodes whose velocity loses its component along the given unit normal
+    /// (frictionless slip; only the outward, separating component is kept if
+    /// `separate` is set).
+    pub slip: Vec<(u32, SVector<f64, D>)>,
+    /// Whether slip nodes may move away from the wall (v·n > 0 kept).
+    pub separate: bool,
+    /// Planar walls the particles may not cross (their nodes are in `fixed`/`slip`).
+    pub walls: Vec<Wall<D>>,
+}
+
+impl<const D: usize> Boundary<D> {
+    /// Nodes of `kernel` within `tolerance` of the plane through `point` with normal `normal`.
+    pub fn nodes_on_plane<K: Kernel<D>>(
+        kernel: &K,
+        point: &SVector<f64, D>,
+        normal: &SVector<f64, D>,
+        tolerance: f64,
+    ) -> Vec<u32> {
+        let unit = normal.normalize();
+        (0..kernel.node_count())
+            .filter(|&n| (kernel.node_position(n) - point).dot(&unit).abs() <= tolerance)
+            .map(|n| n as u32)
+            .collect()
+    }
+
+    /// Nodes of `kernel` on `wall`'s plane (within `tolerance`) or beyond it.
+    pub fn nodes_of_wall<K: Kernel<D>>(kernel: &K, wall: &Wall<D>, tolerance: f64) -> Vec<u32> {
+        (0..kernel.node_count())
+            .filter(|&n| wall.distance(&kernel.node_position(n)) >= -tolerance)
+            .map(|n| n as u32)
+            .collect()
+    }
+
+    /// Adds `wall`: constrains its nodes (on the plane within `tolerance`, or beyond it)
+    /// and keeps particles on the material side. Returns the number of nodes constrained.
+    pub fn add_wall<K: Kernel<D>>(&mut self, kernel: &K, wall: Wall<D>, tolerance: f64) -> usize {
+        let nodes = Self::nodes_of_wall(kernel, &wall, tolerance);
+        let count = nodes.len();
+        match wall.kind {
+            WallKind::Fixed => self.fixed.extend(nodes),
+            WallKind::Slip => self
+                .slip
+                .extend(nodes.into_iter().map(|n| (n, wall.normal))),
+        }
+        self.walls.push(wall);
+        count
+    }
+
+    /// Applies the node conditions to grid velocities.
+    pub(crate) fn apply(&self, velocity: &mut [SVector<f64, D>]) {
+        for &node in &self.fixed {
+            velocity[node as usize] = SVector::zeros();
+        }
+        for (node, normal) in &self.slip {
+            let v = &mut velocity[*node as usize];
+            let vn = v.dot(normal);
+            if !self.separate || vn < 0.0 {
+                *v -= normal * vn;
+            }
+        }
+    }
+
+    /// Keeps a particle on the material side of every wall: a particle beyond a wall is
+    /// put back on its plane and loses its velocity into the wall (all of it at a fixed
+    /// wall). Returns whether the particle was moved.
+    pub(crate) fn hold(&self, x: &mut SVector<f64, D>, v: &mut SVector<f64, D>) -> bool {
+        let mut moved = false;
+        for wall in &self.walls {
+            let depth = wall.distance(x);
+            if depth > 0.0 {
+                *x -= wall.normal * depth;
+                moved = true;
+                match wall.kind {
+                    WallKind::Fixed => *v = SVector::zeros(),
+                    WallKind::Slip => {
+                        let vn = v.dot(&wall.normal);
+                        if vn > 0.0 {
+                            *v -= wall.normal * vn;
+                        }
+                    }
+                }
+            }
+        }
+        moved
+    }
+}

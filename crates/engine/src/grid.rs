@@ -1,0 +1,179 @@
+//! Nodal sums of P2G and the grid update: velocities, forces, damping, boundary
+//! conditions, and the two guards against nodes whose mass cannot carry a velocity.
+//!
+//! **Cancelled nodes.** MLS shape functions can be negative, so a node's mass
+//! m_i = Σ N_ip m_p can be small while the contributions Σ |N_ip| m_p are not: p_i / m_i
+//! is then noise amplified by their ratio. A node with |m_i| ≤ ε Σ |N_ip| m_p carries no
+//! velocity; its mass is counted as dropped and its momentum goes to the active nodes
+//! (see below). Nodes that are merely
+//! light (every contribution small and positive, as at the fringe of a body) are kept,
+//! and so are nodes whose contributions are all negative (m_i < 0 at the fringe of an
+//! MLS stencil: p_i / m_i is still a weighted mean of particle velocities). Non-negative
+//! kernels drop nothing, and neither does UMLS on the scenes measured: momentum is
+//! conserved to round-off.
+//!
+//! A node whose contributions add up to less than 10⁻¹² of a particle mass is round-off
+//! (a particle on a facet or at a vertex gives the opposite vertices N = ±10⁻¹⁷): it is
+//! treated as empty too, since dividing its force by such a mass would lose momentum
+//! to cancellation in the sums.
+//!
+//! **Light, stiff nodes.** A node touched only by particles where N_i is small but ∇N_i
+//! is not (linear elements: N → 0 at a facet while ∇N stays 1/h) has a local explicit
+//! stability limit Δt_i = √(m_i / k_i), k_i = M Σ V_p |∇N_ip|², that goes to zero with
+//! its mass. Its velocity increment Δt f_i / m_i is then unbounded, although the
+//! particles see it only through N_ip Δt f_i / m_i, which stays bounded. The velocity
+//! gradient and the affine matrix, which see it through ∇N_ip, use the mass-scaled
+//! increment Δt f_i / max(m_i, Δt² k_i) (selective mass scaling, as explicit FE codes
+//! do for small elements): unchanged on nodes that satisfy their own stability limit,
+//! bounded on the rest. Velocities and positions keep the exact increment, so momentum
+//! is untouched. This is what lets linear elements run with USL where they inverted
+//! particles before.
+
+use nalgebra::SVector;
+
+use crate::boundary::Boundary;
+use crate::settings::Damping;
+
+/// Nodal fields of one step.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Grid<const D: usize> {
+    /// m_i = Σ N m_p.
+    pub mass: Vec<f64>,
+    /// Σ |N| m_p.
+    pub abs_mass: Vec<f64>,
+    /// p_i = Σ N m_p (v_p + C_p (x_i − x_p)).
+    pub momentum: Vec<SVector<f64, D>>,
+    /// f_i: internal plus external force.
+    pub force: Vec<SVector<f64, D>>,
+    /// Σ V_p |∇N_ip|² (times the p-wave modulus: the node's diagonal stiffness).
+    pub stiffness: Vec<f64>,
+    /// v_i = p_i / m_i.
+    pub velocity: Vec<SVector<f64, D>>,
+    /// ṽ_i = v_i + Δt f_i / m_i, with boundary conditions.
+    pub new_velocity: Vec<SVector<f64, D>>,
+    /// v_i + Δt f_i / max(m_i, Δt² k_i): what velocity gradients and affine matrices read.
+    pub gradient_velocity: Vec<SVector<f64, D>>,
+    /// Contributions below this mass are round-off (10⁻¹² of the heaviest particle).
+    pub round_off_mass: f64,
+}
+
+/// What one grid update set aside.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct GridUpdateReport<const D: usize> {
+    /// Mass of cancelled nodes.
+    pub dropped_mass: f64,
+    /// Momentum p_i + Δt f_i of empty nodes, handed on to the active ones.
+    pub dropped_momentum: SVector<f64, D>,
+    /// Nodes whose increment for velocity gradients was mass-scaled.
+    pub scaled_nodes: usize,
+}
+
+impl<const D: usize> Grid<D> {
+    /// Arrays for `nodes` nodes.
+    pub fn new(nodes: usize, heaviest_particle: f64) -> Self {
+        Self {
+            round_off_mass: 1e-12 * heaviest_particle,
+            mass: vec![0.0; nodes],
+            abs_mass: vec![0.0; nodes],
+            momentum: vec![SVector::zeros(); nodes],
+            force: vec![SVector::zeros(); nodes],
+            stiffness: vec![0.0; nodes],
+            velocity: vec![SVector::zeros(); nodes],
+            new_velocity: vec![SVector::zeros(); nodes],
+            gradient_velocity: vec![SVector::zeros(); nodes],
+        }
+    }
+
+    /// Whether node `i` carries a velocity (see the module docs).
+    #[inline]
+    pub fn is_active(&self, i: usize, cancellation_fraction: f64) -> bool {
+        let m = self.mass[i].abs();
+        self.abs_mass[i] > self.round_off_mass && m > cancellation_fraction * self.abs_mass[i]
+    }
+
+    /// Velocities from momenta and forces, damping, boundary conditions.
+    pub fn update(
+        &mut self,
+        dt: f64,
+        modulus: f64,
+        cancellation_fraction: f64,
+        damping: Damping,
+        boundary: &Boundary<D>,
+    ) -> GridUpdateReport<D> {
+        let mut report = GridUpdateReport {
+            dropped_mass: 0.0,
+            dropped_momentum: SVector::zeros(),
+            scaled_nodes: 0,
+        };
+        for i in 0..self.mass.len() {
+            let m = self.mass[i];
+            if !self.is_active(i, cancellation_fraction) {
+                // A node with no mass at all can still carry a force (N = 0, ∇N ≠ 0).
+                report.dropped_mass += m;
+                report.dropped_momentum += self.momentum[i] + self.force[i] * dt;
+                self.velocity[i] = SVector::zeros();
+                self.new_velocity[i] = SVector::zeros();
+                self.gradient_velocity[i] = SVector::zeros();
+                continue;
+            }
+            let v = self.momentum[i] / m;
+            let f = damped(self.force[i], v, m, damping);
+            let scaled_mass = dt * dt * modulus * self.stiffness[i];
+            self.velocity[i] = v;
+            self.new_velocity[i] = v + f * (dt / m);
+            self.gradient_velocity[i] = if scaled_mass > m.abs() {
+                report.scaled_nodes += 1;
+                v + f * (dt / scaled_mass.copysign(m))
+            } else {
+                self.new_velocity[i]
+            };
+        }
+        // The impulse of empty nodes (a particle exactly on a facet gives the opposite
+        // vertex N = 0 but ∇N ≠ 0, so a force and no mass) goes to the active nodes in
+        // proportion to their mass: momentum stays conserved to round-off, and the
+        // amount is reported.
+        let active_mass: f64 = (0..self.mass.len())
+            .filter(|&i| self.is_active(i, cancellation_fraction))
+            .map(|i| self.mass[i])
+            .sum();
+        if active_mass > 0.0 && report.dropped_momentum.norm_squared() > 0.0 {
+            let shift = report.dropped_momentum / active_mass;
+            for i in 0..self.mass.len() {
+                if self.is_active(i, cancellation_fraction) {
+                    self.new_velocity[i] += shift;
+                }
+            }
+        }
+        boundary.apply(&mut self.velocity);
+        boundary.apply(&mut self.new_velocity);
+        boundary.apply(&mut self.gradient_velocity);
+        report
+    }
+}
+
+/// The nodal force with damping against the node's velocity `v`.
+fn damped<const D: usize>(
+    force: SVector<f64, D>,
+    v: SVector<f64, D>,
+    mass: f64,
+    damping: Damping,
+) -> SVector<f64, D> {
+    match damping {
+        Damping::None => force,
+        Damping::Local { alpha } => {
+            force - SVector::<f64, D>::from_fn(|k, _| alpha * force[k].abs() * signum0(v[k]))
+        }
+        Damping::MassProportional { beta } => force - v * (beta * mass),
+    }
+}
+
+/// sign(x) with sign(0) = 0 (a node at rest is not damped).
+fn signum0(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}

@@ -1,0 +1,101 @@
+//! Step settings: time step control, body loads, stress update, damping, failure checks.
+
+use nalgebra::SVector;
+
+use crate::transfer::StressUpdate;
+
+/// How the time step is chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum TimeStepControl {
+    /// Δt = [`StepSettings::dt`] every step.
+    #[default]
+    Fixed,
+    /// Δt = min(`cfl` · h / (c + |v|_max), [`StepSettings::dt`]) recomputed before every
+    /// step from the current wave speed c and the fastest particle (see
+    /// [`crate::Simulation::stable_time_step`]).
+    Adaptive {
+        /// Courant number C < 1.
+        cfl: f64,
+    },
+}
+
+/// Damping for bringing a body to (quasi-)static equilibrium. It acts on the nodal force
+/// and removes momentum, so it is off for dynamics.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Damping {
+    /// No damping.
+    #[default]
+    None,
+    /// Local non-viscous damping (Cundall): f_i ← f_i − α |f_i| sign(v_i), per component.
+    /// Independent of the time scale; α ≈ 0.1–0.8 (geomechanics codes use 0.7–0.8 for
+    /// quasi-static loading).
+    Local {
+        /// α ∈ [0, 1).
+        alpha: f64,
+    },
+    /// Mass-proportional viscous damping: f_i ← f_i − β m_i v_i, with β in 1/s
+    /// (critical for the mode of angular frequency ω at β = 2ω).
+    MassProportional {
+        /// β ≥ 0.
+        beta: f64,
+    },
+}
+
+/// Step settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepSettings<const D: usize> {
+    /// Time step Δt (the largest one with [`TimeStepControl::Adaptive`]).
+    pub dt: f64,
+    /// Fixed or adaptive time step.
+    pub time_step: TimeStepControl,
+    /// Body acceleration (gravity).
+    pub gravity: SVector<f64, D>,
+    /// Gravity grows linearly from 0 to its full value over this time (0: applied at once),
+    /// for bringing a body to rest under its own weight.
+    pub gravity_ramp: f64,
+    /// Where the stress is updated.
+    pub stress_update: StressUpdate,
+    /// Damping of the nodal forces.
+    pub damping: Damping,
+    /// Stop with [`crate::EngineError::EnergyBlowUp`] when kinetic plus elastic energy
+    /// exceeds this factor times the energy put into the body (initial energy plus the
+    /// largest work of gravity and body forces so far).
+    pub energy_growth_limit: f64,
+    /// Steps between energy checks (they evaluate every particle's energy density).
+    pub energy_check_interval: usize,
+    /// Stop with [`crate::EngineError::Unstable`] when a particle moves more than this many
+    /// kernel spacings in one step.
+    pub max_courant: f64,
+    /// A node whose mass m_i = Σ N m_p is at most this fraction of Σ |N| m_p has lost its
+    /// mass to cancelling (negative) MLS values: it carries no velocity, and its mass and
+    /// momentum are reported as dropped.
+    pub cancellation_fraction: f64,
+}
+
+impl<const D: usize> StepSettings<D> {
+    /// Time step `dt` (fixed), no gravity, USL, no damping, energy limit 10× checked every
+    /// 10 steps, Courant limit 1, cancellation fraction 10⁻³.
+    pub fn new(dt: f64) -> Self {
+        Self {
+            dt,
+            time_step: TimeStepControl::Fixed,
+            gravity: SVector::zeros(),
+            gravity_ramp: 0.0,
+            stress_update: StressUpdate::Usl,
+            damping: Damping::None,
+            energy_growth_limit: 10.0,
+            energy_check_interval: 10,
+            max_courant: 1.0,
+            cancellation_fraction: 1e-3,
+        }
+    }
+
+    /// Gravity at time `t` (with the ramp).
+    pub fn gravity_at(&self, t: f64) -> SVector<f64, D> {
+        if self.gravity_ramp > 0.0 && t < self.gravity_ramp {
+            self.gravity * (t / self.gravity_ramp)
+        } else {
+            self.gravity
+        }
+    }
+}

@@ -1,0 +1,448 @@
+//! Every kernel on the classic cases: the same scene, the same settings, and each kernel
+//! must run it (linear FE with USL included), hold its walls, conserve momentum, and stop
+//! only for a real cause.
+
+use std::sync::Arc;
+
+use nalgebra::{SVector, Vector2, Vector3};
+use umls_constitutive::{Constitutive, ElasticParameters, LinearElastic, NeoHookean};
+use umls_engine::{
+    Apic, Damping, EngineError, Flip, Particles, Pic, Region, Simulation, StepSettings,
+    TimeStepControl, TransferScheme, Wall, WallKind, lattice_samples,
+};
+use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, Umls2, Umls3};
+use umls_mesh::SimplexMesh;
+use umls_mesh::generate::{Diagonal, Lattice};
+use umls_transfer::Kernel;
+
+fn square_mesh(cells: usize) -> Arc<SimplexMesh<2>> {
+    Arc::new(
+        Lattice::new([0.0, 0.0], [1.0, 1.0], [cells, cells])
+            .triangles(Diagonal::Right)
+            .unwrap(),
+    )
+}
+
+fn square_grid(cells: usize, order: BSplineOrder) -> BSplineKernel<2> {
+    let h = 1.0 / cells as f64;
+    BSplineKernel::new(
+        Vector2::new(-2.0 * h, -2.0 * h),
+        h,
+        [cells + 4, cells + 4],
+        order,
+    )
+    .unwrap()
+}
+
+fn elastic(young: f64) -> NeoHookean {
+    NeoHookean {
+        parameters: ElasticParameters::from_young_poisson(young, 0.3).unwrap(),
+    }
+}
+
+/// Particles on a lattice of spacing `h` inside `region`, density 1000, velocity `v`.
+fn body<const D: usize, C: Copy + Default>(
+    lower: SVector<f64, D>,
+    upper: SVector<f64, D>,
+    h: f64,
+    region: &Region<D>,
+    v: SVector<f64, D>,
+) -> Particles<D, (), C> {
+    Particles::seed(&lattice_samples(lower, upper, h), region, 1000.0, (), |_| v)
+}
+
+/// Runs `steps` steps (or to the first error) and returns the error.
+fn run<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme>(
+    sim: &mut Simulation<D, K, M, T>,
+    steps: usize,
+) -> Result<(), EngineError> {
+    for _ in 0..steps {
+        sim.step()?;
+    }
+    Ok(())
+}
+
+/// A disk translating at 0.1 m/s with one particle per cell (particles on the cell
+/// centres, so nodes of the far corners of their triangles get N ≈ 0): linear FE with
+/// USL used to invert particles at step 2. Every kernel now translates it rigidly.
+#[test]
+fn translating_disk_runs_with_every_kernel() {
+    fn translate<K: Kernel<2>>(kernel: K, per_cell: f64) {
+        let disk = Region::Ball {
+            centre: Vector2::new(0.5, 0.5),
+            radius: 0.2,
+        };
+        let particles = body(
+            Vector2::zeros(),
+            Vector2::new(1.0, 1.0),
+            0.05 / per_cell,
+            &disk,
+            Vector2::new(0.1, 0.0),
+        );
+        let mut sim = Simulation::new(
+            kernel,
+            elastic(1e4),
+            Flip { alpha: 1.0 },
+            particles,
+            StepSettings::new(1.0),
+        )
+        .unwrap();
+        sim.settings.dt = sim.stable_time_step(0.3);
+        let before = sim.diagnostics().unwrap();
+        run(&mut sim, 150).unwrap();
+        let after = sim.diagnostics().unwrap();
+        let scale = before.mass * 0.1;
+        assert!((after.momentum - before.momentum).norm() < 1e-12 * scale);
+        assert!(after.elastic < 1e-3 * before.kinetic, "{after:?}");
+        assert!(after.dropped_mass.abs() < 1e-12 * before.mass);
+    }
+    for per_cell in [1.0, 2.0] {
+        translate(LinearFeKernel::new(square_mesh(20)), per_cell);
+        translate(Umls2::new(square_mesh(20)), per_cell);
+        translate(square_grid(20, BSplineOrder::Quadratic), per_cell);
+    }
+}
+
+/// The colliding disks at 10 and 20 cells with PIC, FLIP 0.99 and FLIP 1 run to the end
+/// with every kernel, conserving momentum to round-off (40 cells and APIC: docs/scenes.md).
+#[test]
+fn colliding_disks_run_with_every_kernel_and_transfer() {
+    fn collide<K: Kernel<2>, T: TransferScheme>(kernel: K, transfer: T, cells: usize) {
+        let h = 0.5 / cells as f64;
+        let mut particles = Particles::<2, (), K::Cache>::at_rest(vec![], vec![], 1000.0, ());
+        for (centre, v) in [((0.2, 0.2), 0.1), ((0.8, 0.8), -0.1)] {
+            let disk = Region::Ball {
+                centre: Vector2::new(centre.0, centre.1),
+                radius: 0.2,
+            };
+            particles.append(body(
+                Vector2::zeros(),
+                Vector2::new(1.0, 1.0),
+                h,
+                &disk,
+                Vector2::new(v, v),
+            ));
+        }
+        let material = LinearElastic {
+            parameters: ElasticParameters::from_young_poisson(1000.0, 0.3).unwrap(),
+        };
+        let mut sim = Simulation::new(
+            kernel,
+            material,
+            transfer,
+            particles,
+            StepSettings::new(1e-3),
+        )
+        .unwrap();
+        let before = sim.diagnostics().unwrap();
+        run(&mut sim, 3000).unwrap_or_else(|e| panic!("{} at {cells} cells: {e}", transfer.name()));
+        let after = sim.diagnostics().unwrap();
+        let scale: f64 = sim.particles.mass.iter().sum::<f64>() * 0.1;
+        assert!(
+            (after.momentum - before.momentum).norm() < 1e-12 * scale,
+            "{} {} at {cells} cells: momentum {:?}, dropped mass {}",
+            std::any::type_name::<K>(),
+            transfer.name(),
+            after.momentum,
+            after.dropped_mass
+        );
+        // Pure FLIP does not dissipate: its transfer noise may add a little energy
+        // (linear FE at 10 cells: +1.6 %), an instability adds orders of magnitude.
+        assert!(
+            after.total_energy() < before.total_energy() * 1.05,
+            "{} {} at {cells} cells: energy {} → {}",
+            std::any::type_name::<K>(),
+            transfer.name(),
+            before.total_energy(),
+            after.total_energy()
+        );
+    }
+    for cells in [10, 20] {
+        for alpha in [0.99, 1.0] {
+            collide(
+                LinearFeKernel::new(square_mesh(cells)),
+                Flip { alpha },
+                cells,
+            );
+            collide(Umls2::new(square_mesh(cells)), Flip { alpha }, cells);
+            collide(
+                square_grid(cells, BSplineOrder::Quadratic),
+                Flip { alpha },
+                cells,
+            );
+        }
+        collide(LinearFeKernel::new(square_mesh(cells)), Pic, cells);
+        collide(Umls2::new(square_mesh(cells)), Pic, cells);
+        collide(Umls2::new(square_mesh(cells)), Apic, cells);
+        collide(square_grid(cells, BSplineOrder::Quadratic), Apic, cells);
+    }
+}
+
+/// Hydrostatic column (width 1, height 4, ρ 1000, g 10, E 10⁶, ν 0.3) between slip walls
+/// on a slip base, each wall one plane, brought to rest by local damping. Returns the
+/// mean σ_yy of the particles whose initial height lies in `band` over the exact
+/// −ρg(H − y).
+fn column<K: Kernel<2>>(kernel: K, geostatic: bool, band: (f64, f64)) -> f64 {
+    let height = 4.0;
+    let region = Region::Box {
+        lower: Vector2::zeros(),
+        upper: Vector2::new(1.0, height),
+    };
+    let particles = body(
+        Vector2::zeros(),
+        Vector2::new(1.0, height),
+        0.05,
+        &region,
+        Vector2::zeros(),
+    );
+    let material = LinearElastic {
+        parameters: ElasticParameters::from_young_poisson(1e6, 0.3).unwrap(),
+    };
+    let mut settings = StepSettings::new(1.0);
+    settings.gravity = Vector2::new(0.0, -10.0);
+    settings.damping = Damping::Local { alpha: 0.7 };
+    let mut sim = Simulation::new(kernel, material, Pic, particles, settings).unwrap();
+    sim.settings.dt = sim.stable_time_step(0.3);
+    let positions = sim.particles.position.clone();
+    for (point, normal) in [
+        ((0.0, 0.0), (1.0, 0.0)),
+        ((1.0, 0.0), (1.0, 0.0)),
+        ((0.0, 0.0), (0.0, 1.0)),
+    ] {
+        let wall = Wall::facing(
+            WallKind::Slip,
+            Vector2::new(point.0, point.1),
+            Vector2::new(normal.0, normal.1),
+            &positions,
+        )
+        .unwrap();
+        assert!(sim.boundary.add_wall(&sim.kernel, wall, 1e-9) > 0);
+    }
+    let end = if geostatic {
+        sim.set_geostatic_stress(0.3 / 0.7).unwrap();
+        0.05
+    } else {
+        1.5
+    };
+    let steps = (end / sim.settings.dt).ceil() as usize;
+    run(&mut sim, steps).unwrap();
+    let d = sim.diagnostics().unwrap();
+    assert!(d.max_speed < 0.02, "column not at rest: {d:?}");
+    // Particles may not leave through the walls.
+    assert!(
+        sim.particles
+            .position
+            .iter()
+            .all(|x| x.x >= 0.0 && x.x <= 1.0 && x.y >= 0.0)
+    );
+    let stresses = sim.stresses().unwrap();
+    let row = |(bottom, top): (f64, f64)| {
+        let (mut sum, mut exact) = (0.0, 0.0);
+        for (x0, tau) in positions.iter().zip(&stresses) {
+            if bottom <= x0.y && x0.y < top {
+                sum += tau[(1, 1)];
+                exact += -1000.0 * 10.0 * (height - x0.y);
+            }
+        }
+        sum / exact
+    };
+    row(band)
+}
+
+#[test]
+fn bspline_column_with_one_plane_per_wall_carries_its_weight() {
+    // The bottom row: the lowest row of particles.
+    let ratio = column(
+        square_grid_column(BSplineOrder::Quadratic),
+        false,
+        BOTTOM_ROW,
+    );
+    assert!(
+        (ratio - 1.0).abs() < 0.1,
+        "bspline2 bottom row σ_yy / exact = {ratio}"
+    );
+    // The cubic stencil reaches two cells into the wall: 1.10 measured, reported in
+    // docs/scenes.md; guarded here against getting worse.
+    let ratio = column(square_grid_column(BSplineOrder::Cubic), false, BOTTOM_ROW);
+    assert!(
+        (ratio - 1.0).abs() < 0.12,
+        "bspline3 bottom row σ_yy / exact = {ratio}"
+    );
+}
+
+#[test]
+fn mesh_kernels_bring_the_soft_column_to_rest() {
+    let mesh = Arc::new(
+        Lattice::new([0.0, 0.0], [1.0, 4.4], [10, 44])
+            .triangles(Diagonal::Alternating)
+            .unwrap(),
+    );
+    let fe = column(LinearFeKernel::new(mesh.clone()), false, BOTTOM_ROW);
+    let umls = column(Umls2::new(mesh), false, BOTTOM_ROW);
+    eprintln!("soft column, bottom row σ_yy / exact: linear FE {fe:.3}, UMLS {umls:.3}");
+    // The mesh kernels' boundary accuracy is the subject of their own study; here they
+    // must settle, with a bottom row of the right sign and magnitude.
+    assert!(fe > 0.5 && fe < 1.5, "linear FE {fe}");
+    assert!(umls > 0.5 && umls < 2.5, "UMLS {umls}");
+}
+
+#[test]
+fn geostatic_initial_stress_starts_the_column_at_rest() {
+    // Without it the column drops: after 0.05 s it moves at about g t = 0.5 m/s (the
+    // check inside `column` asks for less than 0.02 m/s).
+    // And it keeps its stress away from the base, where the kernel's own equilibrium
+    // differs from the exact one.
+    let ratio = column(
+        square_grid_column(BSplineOrder::Quadratic),
+        true,
+        (1.0, 3.0),
+    );
+    assert!((ratio - 1.0).abs() < 0.05, "{ratio}");
+}
+
+const BOTTOM_ROW: (f64, f64) = (0.0, 0.05);
+
+fn square_grid_column(order: BSplineOrder) -> BSplineKernel<2> {
+    BSplineKernel::new(Vector2::new(-0.2, -0.2), 0.1, [14, 48], order).unwrap()
+}
+
+/// A block thrown into the corner of a fixed floor and a slip wall: no particle ends
+/// up beyond either plane, for every kernel, in 2D and 3D.
+#[test]
+fn walls_hold_for_every_kernel() {
+    fn throw<const D: usize, K: Kernel<D>>(kernel: K, name: &str, cell: f64) {
+        let lower = SVector::<f64, D>::from_element(0.25);
+        let upper = SVector::<f64, D>::from_element(0.65);
+        let region = Region::Box { lower, upper };
+        let mut velocity = SVector::<f64, D>::zeros();
+        velocity[0] = -2.0;
+        velocity[D - 1] = -3.0;
+        let particles = body(lower, upper, 0.05, &region, velocity);
+        let mut settings = StepSettings::new(1.0);
+        settings.time_step = TimeStepControl::Adaptive { cfl: 0.3 };
+        let mut sim = Simulation::new(kernel, elastic(2e5), Pic, particles, settings).unwrap();
+        sim.settings.dt = 1e-3;
+        let positions = sim.particles.position.clone();
+        let mut floor = SVector::<f64, D>::zeros();
+        floor[D - 1] = 1.0;
+        let mut side = SVector::<f64, D>::zeros();
+        side[0] = 1.0;
+        for (kind, normal) in [(WallKind::Fixed, floor), (WallKind::Slip, side)] {
+            let wall = Wall::facing(kind, SVector::zeros(), normal, &positions).unwrap();
+            assert_eq!(wall.normal, -normal);
+            sim.boundary.add_wall(&sim.kernel, wall, 1e-9);
+        }
+        let mut lowest = f64::INFINITY;
+        while sim.time() < 0.4 {
+            sim.step().unwrap_or_else(|e| panic!("{name} {D}D: {e}"));
+            for x in &sim.particles.position {
+                assert!(
+                    x[0] >= 0.0 && x[D - 1] >= 0.0,
+                    "{name} {D}D: {x:?} beyond a wall"
+                );
+                lowest = lowest.min(x[D - 1]);
+            }
+        }
+        // Pressed into the floor: within 1.5 cells of it. (Fixed wall nodes slow the
+        // particles within a stencil of the wall: UMLS keeps them 1.0 cell away in 2D
+        // and 1.15 in 3D, linear FE 0.64 in 2D.)
+        assert!(
+            lowest < 1.5 * cell,
+            "{name} {D}D never reached the floor: {lowest}"
+        );
+    }
+    throw(LinearFeKernel::new(square_mesh(10)), "linear FE", 0.1);
+    throw(Umls2::new(square_mesh(10)), "UMLS", 0.1);
+    throw(square_grid(10, BSplineOrder::Quadratic), "bspline2", 0.1);
+    let cube = Arc::new(
+        Lattice::new([0.0; 3], [1.0; 3], [6, 6, 6])
+            .tetrahedra()
+            .unwrap(),
+    );
+    throw(LinearFeKernel::new(cube.clone()), "linear FE", 1.0 / 6.0);
+    throw(Umls3::new(cube), "UMLS", 1.0 / 6.0);
+    let h = 1.0 / 6.0;
+    let grid = BSplineKernel::new(
+        Vector3::from_element(-2.0 * h),
+        h,
+        [10, 10, 10],
+        BSplineOrder::Quadratic,
+    )
+    .unwrap();
+    throw(grid, "bspline2", 1.0 / 6.0);
+}
+
+/// A disk thrown sideways under gravity: the energy check counts the work of gravity, so
+/// the fall runs to the end (it stopped after 11 steps), and kinetic + elastic energy
+/// minus that work stays constant.
+#[test]
+fn free_fall_with_initial_velocity_runs_to_the_end() {
+    let disk = Region::Ball {
+        centre: Vector2::new(0.3, 0.8),
+        radius: 0.1,
+    };
+    let particles = body(
+        Vector2::zeros(),
+        Vector2::new(1.0, 1.0),
+        0.025,
+        &disk,
+        Vector2::new(0.1, 0.0),
+    );
+    let mut settings = StepSettings::new(1e-3);
+    settings.gravity = Vector2::new(0.0, -10.0);
+    let mut sim = Simulation::new(
+        square_grid(20, BSplineOrder::Quadratic),
+        elastic(1e5),
+        Flip { alpha: 1.0 },
+        particles,
+        settings,
+    )
+    .unwrap();
+    let before = sim.diagnostics().unwrap();
+    run(&mut sim, 300).unwrap();
+    let after = sim.diagnostics().unwrap();
+    let fallen = 0.5 * 10.0 * 0.3f64.powi(2);
+    assert!((after.external_work - before.mass * 10.0 * fallen).abs() < 0.02 * after.external_work);
+    assert!(
+        (after.energy_balance() - before.energy_balance()).abs() < 1e-6 * after.external_work,
+        "{} → {}",
+        before.energy_balance(),
+        after.energy_balance()
+    );
+}
+
+/// A fixed Δt four times the stable step: the wave Courant number says so before the
+/// first step, and the run stops with a typed instability instead of completing.
+#[test]
+fn unstable_time_step_is_reported() {
+    let disk = Region::Ball {
+        centre: Vector2::new(0.5, 0.5),
+        radius: 0.2,
+    };
+    let particles = body(
+        Vector2::zeros(),
+        Vector2::new(1.0, 1.0),
+        0.025,
+        &disk,
+        Vector2::new(0.1, 0.0),
+    );
+    let mut sim = Simulation::new(
+        square_grid(20, BSplineOrder::Quadratic),
+        elastic(1e4),
+        Flip { alpha: 1.0 },
+        particles,
+        StepSettings::new(1.0),
+    )
+    .unwrap();
+    sim.settings.dt = 4.0 * sim.stable_time_step(1.0);
+    let d = sim.diagnostics().unwrap();
+    assert!((d.wave_courant - 4.0).abs() < 1e-9, "{}", d.wave_courant);
+    let error = run(&mut sim, 400).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            EngineError::EnergyBlowUp { .. } | EngineError::Unstable { .. }
+        ),
+        "{error}"
+    );
+}
