@@ -172,6 +172,9 @@ fn colliding_disks_run_with_every_kernel_and_transfer() {
             );
         }
         collide(LinearFeKernel::new(square_mesh(cells)), Pic, cells);
+        // Linear FE with APIC gains energy once the disks touch and blows up (the
+        // affine matrix is the host element's gradient and jumps at every element
+        // change): a recorded failure (docs/scenes.md), not run here.
         collide(Umls2::new(square_mesh(cells)), Pic, cells);
         collide(Umls2::new(square_mesh(cells)), Apic, cells);
         collide(square_grid(cells, BSplineOrder::Quadratic), Apic, cells);

@@ -8,7 +8,7 @@
 use std::sync::Arc;
 
 use nalgebra::SVector;
-use umls_engine::{Apic, EngineError, Flip, Simulation, StepSettings};
+use umls_engine::{Apic, Flip, Simulation, StepSettings};
 use umls_kernels::{BSplineKernel, BSplineOrder, HostCache, LinearFeKernel, Umls1};
 use umls_scenes::vibrating_bar::{BarError, FixedEnd, VibratingBar};
 
@@ -93,10 +93,12 @@ fn node_and_mirror_agree_for_interpolating_kernels() {
     );
 }
 
-/// Pure FLIP with two particles per cell on linear FE is the textbook unstable case
-/// (grid-invisible particle modes ring and grow): the run must stop with a typed error.
+/// Pure FLIP with two particles per cell on linear FE: it used to blow up within 5000
+/// steps, which was the light-node instability of linear elements (a node reached only
+/// where N → 0 took an unbounded velocity-gradient increment), not FLIP's ringing. With
+/// mass-scaled gradient increments it runs, and its energy stays bounded.
 #[test]
-fn pure_flip_instability_is_detected() {
+fn pure_flip_on_linear_elements_stays_bounded() {
     let bar = VibratingBar {
         cells: 64,
         particles_per_cell: 2,
@@ -114,13 +116,13 @@ fn pure_flip_instability_is_detected() {
     )
     .unwrap();
     sim.boundary.fixed = vec![0];
-    let error = (0..5000)
-        .find_map(|_| sim.step().err())
-        .expect("pure FLIP must go unstable");
-    assert!(
-        matches!(error, EngineError::EnergyBlowUp { factor, .. } if factor == 10.0),
-        "{error}"
-    );
+    let start = sim.diagnostics().unwrap().total_energy();
+    for _ in 0..5000 {
+        sim.step().unwrap();
+    }
+    let end = sim.diagnostics().unwrap().total_energy();
+    // Measured: 0.0625 → 0.0546 (87 %).
+    assert!(end < 1.05 * start && end > 0.8 * start, "{start} -> {end}");
 }
 
 #[test]
