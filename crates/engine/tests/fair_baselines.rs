@@ -51,6 +51,19 @@ fn body<const D: usize, C: Copy + Default>(
     Particles::seed(&lattice_samples(lower, upper, h), region, 1000.0, (), |_| v)
 }
 
+/// A disk of particles on a lattice of spacing `h` in the unit square, moving at
+/// (0.1, 0) m/s.
+fn disk<C: Copy + Default>(centre: Vector2<f64>, radius: f64, h: f64) -> Particles<2, (), C> {
+    let region = Region::Ball { centre, radius };
+    body(
+        Vector2::zeros(),
+        Vector2::new(1.0, 1.0),
+        h,
+        &region,
+        Vector2::new(0.1, 0.0),
+    )
+}
+
 /// Runs `steps` steps (or to the first error) and returns the error.
 fn run<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme>(
     sim: &mut Simulation<D, K, M, T>,
@@ -68,17 +81,7 @@ fn run<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme>(
 #[test]
 fn translating_disk_runs_with_every_kernel() {
     fn translate<K: Kernel<2>>(kernel: K, per_cell: f64) {
-        let disk = Region::Ball {
-            centre: Vector2::new(0.5, 0.5),
-            radius: 0.2,
-        };
-        let particles = body(
-            Vector2::zeros(),
-            Vector2::new(1.0, 1.0),
-            0.05 / per_cell,
-            &disk,
-            Vector2::new(0.1, 0.0),
-        );
+        let particles = disk(Vector2::new(0.5, 0.5), 0.2, 0.05 / per_cell);
         let mut sim = Simulation::new(
             kernel,
             elastic(1e4),
@@ -380,17 +383,7 @@ fn walls_hold_for_every_kernel() {
 /// minus that work stays constant.
 #[test]
 fn free_fall_with_initial_velocity_runs_to_the_end() {
-    let disk = Region::Ball {
-        centre: Vector2::new(0.3, 0.8),
-        radius: 0.1,
-    };
-    let particles = body(
-        Vector2::zeros(),
-        Vector2::new(1.0, 1.0),
-        0.025,
-        &disk,
-        Vector2::new(0.1, 0.0),
-    );
+    let particles = disk(Vector2::new(0.3, 0.8), 0.1, 0.025);
     let mut settings = StepSettings::new(1e-3);
     settings.gravity = Vector2::new(0.0, -10.0);
     let mut sim = Simulation::new(
@@ -418,17 +411,7 @@ fn free_fall_with_initial_velocity_runs_to_the_end() {
 /// first step, and the run stops with a typed instability instead of completing.
 #[test]
 fn unstable_time_step_is_reported() {
-    let disk = Region::Ball {
-        centre: Vector2::new(0.5, 0.5),
-        radius: 0.2,
-    };
-    let particles = body(
-        Vector2::zeros(),
-        Vector2::new(1.0, 1.0),
-        0.025,
-        &disk,
-        Vector2::new(0.1, 0.0),
-    );
+    let particles = disk(Vector2::new(0.5, 0.5), 0.2, 0.025);
     let mut sim = Simulation::new(
         square_grid(20, BSplineOrder::Quadratic),
         elastic(1e4),
