@@ -531,8 +531,8 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     );
     metrics.insert("dropped_mass".into(), json!(last.dropped_mass));
     metrics.insert(
-        "dropped_momentum".into(),
-        json!(last.dropped_momentum.norm()),
+        "redistributed_momentum".into(),
+        json!(last.redistributed_momentum.norm()),
     );
     metrics.insert("wall_corrections".into(), json!(last.wall_corrections));
     if setup.reference.is_some() && taken > 0 {

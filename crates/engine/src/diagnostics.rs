@@ -34,10 +34,11 @@ pub struct Diagnostics<const D: usize> {
     /// Mass of empty nodes (cancelled by negative shape functions, or reached only by
     /// round-off), summed over the steps.
     pub dropped_mass: f64,
-    /// Momentum of empty nodes (cancelled, or reached only by round-off), summed over the
-    /// steps: handed on to the active nodes in proportion to their mass, so that momentum
-    /// is conserved; its size says how much the grid update redistributed.
-    pub dropped_momentum: SVector<f64, D>,
+    /// Momentum the grid update handed on to the active nodes in proportion to their
+    /// mass, summed over the steps: that of empty nodes (cancelled, or reached only by
+    /// round-off) and the impulse mass-scaled nodes did not absorb. Momentum is conserved;
+    /// this says how much was moved.
+    pub redistributed_momentum: SVector<f64, D>,
     /// How many times a particle was put back from beyond a wall.
     pub wall_corrections: usize,
 }
@@ -60,7 +61,7 @@ impl<const D: usize> Diagnostics<D> {
 pub(crate) struct Totals<const D: usize> {
     pub external_work: f64,
     pub dropped_mass: f64,
-    pub dropped_momentum: SVector<f64, D>,
+    pub redistributed_momentum: SVector<f64, D>,
     pub wall_corrections: usize,
     /// Kinetic plus elastic energy at the start (set before the first step).
     pub initial_energy: Option<f64>,
@@ -69,6 +70,8 @@ pub(crate) struct Totals<const D: usize> {
     /// Fastest particle and smallest density after the last step.
     pub max_speed: f64,
     pub min_density: f64,
+    /// The particle that moved farthest in the last step, and how far.
+    pub longest_move: (usize, f64),
 }
 
 impl<const D: usize> Default for Totals<D> {
@@ -76,12 +79,13 @@ impl<const D: usize> Default for Totals<D> {
         Self {
             external_work: 0.0,
             dropped_mass: 0.0,
-            dropped_momentum: SVector::zeros(),
+            redistributed_momentum: SVector::zeros(),
             wall_corrections: 0,
             initial_energy: None,
             energy_supplied: 0.0,
             max_speed: 0.0,
             min_density: f64::INFINITY,
+            longest_move: (0, 0.0),
         }
     }
 }

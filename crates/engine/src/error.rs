@@ -81,6 +81,20 @@ pub enum EngineError {
         /// The configured limit.
         limit: f64,
     },
+    /// The time step exceeds the explicit stability limit.
+    #[error(
+        "step {step}: Δt = {dt:e} exceeds the stable step {stable:e} (wave Courant number {wave_courant:.3} > the limit): use a smaller dt or cfl, or an adaptive time step"
+    )]
+    TimeStepTooLarge {
+        /// Step number.
+        step: usize,
+        /// The time step.
+        dt: f64,
+        /// The stable step h / (c + |v|_max).
+        stable: f64,
+        /// Their ratio.
+        wave_courant: f64,
+    },
     /// The initial stress could not be imposed on a particle.
     #[error("particle {particle}: cannot impose the initial stress: {reason}")]
     InitialStress {

@@ -20,14 +20,17 @@
 //! **Light, stiff nodes.** A node touched only by particles where N_i is small but ∇N_i
 //! is not (linear elements: N → 0 at a facet while ∇N stays 1/h) has a local explicit
 //! stability limit Δt_i = √(m_i / k_i), k_i = M Σ V_p |∇N_ip|², that goes to zero with
-//! its mass. Its velocity increment Δt f_i / m_i is then unbounded, although the
-//! particles see it only through N_ip Δt f_i / m_i, which stays bounded. The velocity
-//! gradient and the affine matrix, which see it through ∇N_ip, use the mass-scaled
-//! increment Δt f_i / max(m_i, Δt² k_i) (selective mass scaling, as explicit FE codes
-//! do for small elements): unchanged on nodes that satisfy their own stability limit,
-//! bounded on the rest. Velocities and positions keep the exact increment, so momentum
-//! is untouched. This is what lets linear elements run with USL where they inverted
-//! particles before.
+//! its mass. Its increment Δt f_i / m_i is then unbounded: the particles see it through
+//! N_ip (bounded) but the velocity gradient sees it through ∇N_ip, and F inverts. Such a
+//! node moves with the increment Δt f_i / (Δt² k_i) instead (selective mass scaling, as
+//! explicit FE codes do for small elements); nodes within their own stability limit are
+//! untouched. The same scaled velocity serves velocities, gradients and affine matrices:
+//! scaling only the gradient would break the balance between the work of the nodal
+//! forces and the change of stored energy by f_i·Δt² f_i (1/m_i − 1/Δt² k_i) > 0 per
+//! step, which transfers without loss (APIC on linear elements) turn into growing
+//! energy. The impulse the scaled node does not absorb, Δt f_i (1 − m_i / Δt² k_i), goes
+//! to the active nodes in proportion to their mass, so momentum is conserved. This is
+//! what lets linear elements run with USL where they inverted particles before.
 
 use nalgebra::SVector;
 
@@ -49,10 +52,9 @@ pub(crate) struct Grid<const D: usize> {
     pub stiffness: Vec<f64>,
     /// v_i = p_i / m_i.
     pub velocity: Vec<SVector<f64, D>>,
-    /// ṽ_i = v_i + Δt f_i / m_i, with boundary conditions.
+    /// ṽ_i = v_i + Δt f_i / m_i (Δt f_i / Δt² k_i on mass-scaled nodes), plus the
+    /// redistributed impulse, with boundary conditions.
     pub new_velocity: Vec<SVector<f64, D>>,
-    /// v_i + Δt f_i / max(m_i, Δt² k_i): what velocity gradients and affine matrices read.
-    pub gradient_velocity: Vec<SVector<f64, D>>,
     /// Contributions below this mass are round-off (10⁻¹² of the heaviest particle).
     pub round_off_mass: f64,
 }
@@ -62,8 +64,9 @@ pub(crate) struct Grid<const D: usize> {
 pub(crate) struct GridUpdateReport<const D: usize> {
     /// Mass of cancelled nodes.
     pub dropped_mass: f64,
-    /// Momentum p_i + Δt f_i of empty nodes, handed on to the active ones.
-    pub dropped_momentum: SVector<f64, D>,
+    /// Momentum p_i + Δt f_i of empty nodes and the impulse mass-scaled nodes could not
+    /// absorb, handed on to the active nodes.
+    pub redistributed_momentum: SVector<f64, D>,
     /// Nodes whose increment for velocity gradients was mass-scaled.
     pub scaled_nodes: usize,
 }
@@ -80,7 +83,6 @@ impl<const D: usize> Grid<D> {
             stiffness: vec![0.0; nodes],
             velocity: vec![SVector::zeros(); nodes],
             new_velocity: vec![SVector::zeros(); nodes],
-            gradient_velocity: vec![SVector::zeros(); nodes],
         }
     }
 
@@ -102,7 +104,7 @@ impl<const D: usize> Grid<D> {
     ) -> GridUpdateReport<D> {
         let mut report = GridUpdateReport {
             dropped_mass: 0.0,
-            dropped_momentum: SVector::zeros(),
+            redistributed_momentum: SVector::zeros(),
             scaled_nodes: 0,
         };
         for i in 0..self.mass.len() {
@@ -110,34 +112,35 @@ impl<const D: usize> Grid<D> {
             if !self.is_active(i, cancellation_fraction) {
                 // A node with no mass at all can still carry a force (N = 0, ∇N ≠ 0).
                 report.dropped_mass += m;
-                report.dropped_momentum += self.momentum[i] + self.force[i] * dt;
+                report.redistributed_momentum += self.momentum[i] + self.force[i] * dt;
                 self.velocity[i] = SVector::zeros();
                 self.new_velocity[i] = SVector::zeros();
-                self.gradient_velocity[i] = SVector::zeros();
                 continue;
             }
             let v = self.momentum[i] / m;
             let f = damped(self.force[i], v, m, damping);
             let scaled_mass = dt * dt * modulus * self.stiffness[i];
             self.velocity[i] = v;
-            self.new_velocity[i] = v + f * (dt / m);
-            self.gradient_velocity[i] = if scaled_mass > m.abs() {
+            if scaled_mass > m.abs() {
+                // Selective mass scaling: the node moves as if it had mass Δt² k, and the
+                // impulse it cannot absorb goes to the active nodes with the rest.
                 report.scaled_nodes += 1;
-                v + f * (dt / scaled_mass.copysign(m))
+                self.new_velocity[i] = v + f * (dt / scaled_mass.copysign(m));
+                report.redistributed_momentum += f * (dt * (1.0 - m.abs() / scaled_mass));
             } else {
-                self.new_velocity[i]
-            };
+                self.new_velocity[i] = v + f * (dt / m);
+            }
         }
         // The impulse of empty nodes (a particle exactly on a facet gives the opposite
-        // vertex N = 0 but ∇N ≠ 0, so a force and no mass) goes to the active nodes in
-        // proportion to their mass: momentum stays conserved to round-off, and the
-        // amount is reported.
+        // vertex N = 0 but ∇N ≠ 0, so a force and no mass) and what mass-scaled nodes
+        // did not absorb go to the active nodes in proportion to their mass: momentum
+        // stays conserved to round-off, and the amount is reported.
         let active_mass: f64 = (0..self.mass.len())
             .filter(|&i| self.is_active(i, cancellation_fraction))
             .map(|i| self.mass[i])
             .sum();
-        if active_mass > 0.0 && report.dropped_momentum.norm_squared() > 0.0 {
-            let shift = report.dropped_momentum / active_mass;
+        if active_mass > 0.0 && report.redistributed_momentum.norm_squared() > 0.0 {
+            let shift = report.redistributed_momentum / active_mass;
             for i in 0..self.mass.len() {
                 if self.is_active(i, cancellation_fraction) {
                     self.new_velocity[i] += shift;
@@ -146,7 +149,6 @@ impl<const D: usize> Grid<D> {
         }
         boundary.apply(&mut self.velocity);
         boundary.apply(&mut self.new_velocity);
-        boundary.apply(&mut self.gradient_velocity);
         report
     }
 }

@@ -12,6 +12,10 @@ pub struct Particles<const D: usize, S, C> {
     pub velocity: Vec<SVector<f64, D>>,
     /// Affine velocity matrices C_p (APIC / affine transfers; zero for PIC and FLIP).
     pub affine: Vec<SMatrix<f64, D, D>>,
+    /// tr(C_p D_p C_pᵀ) with D_p = Σ N_i (x_i − x_p)(x_i − x_p)ᵀ where G2P set C_p: twice
+    /// the kinetic energy per unit mass of the affine motion, which the next P2G may not
+    /// exceed (infinite until the first G2P: a C_p given by the user is kept).
+    pub affine_moment: Vec<f64>,
     /// Deformation gradients F_p.
     pub deformation: Vec<SMatrix<f64, D, D>>,
     /// Reference volumes V_p⁰.
@@ -37,6 +41,7 @@ impl<const D: usize, S: Clone, C: Copy + Default> Particles<D, S, C> {
         Self {
             velocity: vec![SVector::zeros(); n],
             affine: vec![SMatrix::zeros(); n],
+            affine_moment: vec![f64::INFINITY; n],
             deformation: vec![SMatrix::identity(); n],
             mass: volumes.iter().map(|v| v * density).collect(),
             volume: volumes,

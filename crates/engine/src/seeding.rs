@@ -121,6 +121,7 @@ impl<const D: usize, S: Clone, C: Copy + Default> Particles<D, S, C> {
         self.position.extend(other.position);
         self.velocity.extend(other.velocity);
         self.affine.extend(other.affine);
+        self.affine_moment.extend(other.affine_moment);
         self.deformation.extend(other.deformation);
         self.volume.extend(other.volume);
         self.mass.extend(other.mass);

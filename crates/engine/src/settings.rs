@@ -66,6 +66,11 @@ pub struct StepSettings<const D: usize> {
     /// Stop with [`crate::EngineError::Unstable`] when a particle moves more than this many
     /// kernel spacings in one step.
     pub max_courant: f64,
+    /// Stop with [`crate::EngineError::TimeStepTooLarge`] when Δt exceeds this many stable
+    /// steps h / (c + |v|_max) (checked after every step; `f64::INFINITY` switches it
+    /// off). Beyond 1 the explicit step is unstable; the grid update's mass scaling would
+    /// then slow the whole body down instead of letting it blow up, so the run is stopped.
+    pub max_wave_courant: f64,
     /// A node whose mass m_i = Σ N m_p is at most this fraction of Σ |N| m_p has lost its
     /// mass to cancelling (negative) MLS values: it carries no velocity, and its mass and
     /// momentum are reported as dropped.
@@ -74,7 +79,7 @@ pub struct StepSettings<const D: usize> {
 
 impl<const D: usize> StepSettings<D> {
     /// Time step `dt` (fixed), no gravity, USL, no damping, energy limit 10× checked every
-    /// 10 steps, Courant limit 1, cancellation fraction 10⁻³.
+    /// 10 steps, Courant and wave Courant limits 1, cancellation fraction 10⁻³.
     pub fn new(dt: f64) -> Self {
         Self {
             dt,
@@ -86,6 +91,7 @@ impl<const D: usize> StepSettings<D> {
             energy_growth_limit: 10.0,
             energy_check_interval: 10,
             max_courant: 1.0,
+            max_wave_courant: 1.0,
             cancellation_fraction: 1e-3,
         }
     }

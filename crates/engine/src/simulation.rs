@@ -57,7 +57,39 @@ struct ParticleUpdate<const D: usize> {
     /// Moved with the PIC velocity Σ N ṽ_i.
     position: SVector<f64, D>,
     affine: SMatrix<f64, D, D>,
+    affine_moment: f64,
     velocity_gradient: SMatrix<f64, D, D>,
+}
+
+/// The affine matrix P2G spreads: C_p, scaled down if its kinetic energy at the
+/// particle's new position, tr(C D C^T) with D = Σ N r rᵀ there, exceeds what it had
+/// where G2P made it. For B-splines D is constant and nothing changes; for linear
+/// elements D goes from 0 at a vertex to its largest at the centroid, so a particle
+/// moving away from a vertex would carry the affine energy up with it — the energy
+/// source that blew up linear elements with APIC. Skipped where D is not positive
+/// (negative MLS values): there the bound means nothing.
+fn limited_affine<const D: usize, K: Kernel<D>>(
+    c: &SMatrix<f64, D, D>,
+    moment: f64,
+    stencils: &Stencils<D>,
+    i: usize,
+    kernel: &K,
+    x: &SVector<f64, D>,
+) -> SMatrix<f64, D, D> {
+    if !moment.is_finite() || moment <= 0.0 {
+        return if moment == 0.0 { SMatrix::zeros() } else { *c };
+    }
+    let mut d = SMatrix::<f64, D, D>::zeros();
+    for e in stencils.range(i) {
+        let r = kernel.node_position(stencils.nodes[e] as usize) - x;
+        d += r * r.transpose() * stencils.values[e];
+    }
+    let now = (c * d * c.transpose()).trace();
+    if now > moment * (1.0 + 1e-9) {
+        c * (moment / now).sqrt()
+    } else {
+        *c
+    }
 }
 
 /// An MPM simulation.
@@ -124,6 +156,13 @@ impl<const D: usize> StepSettings<D> {
             self.energy_check_interval >= 1,
             "must be at least 1",
         )?;
+        if self.max_wave_courant.is_nan() || self.max_wave_courant <= 0.0 {
+            return Err(EngineError::InvalidParameter {
+                parameter: "max_wave_courant",
+                value: self.max_wave_courant,
+                reason: "must be positive (infinite switches the check off)",
+            });
+        }
         check(
             "max_courant",
             self.max_courant,
@@ -318,7 +357,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             courant: max_speed * dt / h,
             wave_courant: (c + max_speed) * dt / h,
             dropped_mass: self.totals.dropped_mass,
-            dropped_momentum: self.totals.dropped_momentum,
+            redistributed_momentum: self.totals.redistributed_momentum,
             wall_corrections: self.totals.wall_corrections,
         })
     }
@@ -380,6 +419,17 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             )),
         };
         self.dt = dt;
+        // The stability limit with the speeds and densities the step starts from (those
+        // an adaptive step is sized by, so a cfl ≤ 1 never trips it).
+        let stable = self.stable_step_from(1.0, self.totals.max_speed, self.totals.min_density);
+        if dt > self.settings.max_wave_courant * stable {
+            return Err(EngineError::TimeStepTooLarge {
+                step,
+                dt,
+                stable,
+                wave_courant: dt / stable,
+            });
+        }
         // 1. Stencils.
         self.stencils
             .compute(
@@ -403,19 +453,18 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             &self.boundary,
         );
         self.totals.dropped_mass += report.dropped_mass;
-        self.totals.dropped_momentum += report.dropped_momentum;
+        self.totals.redistributed_momentum += report.redistributed_momentum;
         if let Some(node) = self
             .grid
             .new_velocity
             .iter()
-            .chain(&self.grid.gradient_velocity)
             .position(|v| !v.iter().all(|c| c.is_finite()))
         {
             return Err(EngineError::NonFinite {
                 step,
                 field: "velocity",
                 entity: "node",
-                index: node % self.grid.mass.len(),
+                index: node,
             });
         }
         // 4. G2P and walls.
@@ -460,7 +509,12 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 let end = ((block + 1) * block_len).min(p.len());
                 let start = (block * block_len).min(end);
                 for (i, stress) in stresses.iter().enumerate().take(end).skip(start) {
-                    let (m, v, c, x) = (p.mass[i], p.velocity[i], p.affine[i], p.position[i]);
+                    let (m, v, x) = (p.mass[i], p.velocity[i], p.position[i]);
+                    let c = if T::AFFINE {
+                        limited_affine(&p.affine[i], p.affine_moment[i], stencils, i, kernel, &x)
+                    } else {
+                        SMatrix::zeros()
+                    };
                     let volume = p.volume[i];
                     let stress_volume = stress * volume;
                     let acceleration =
@@ -507,14 +561,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     }
 
     /// G2P: velocity, affine matrix, position, velocity gradient; then the walls. Returns
-    /// the velocity gradients (from the mass-scaled grid velocities, see `grid.rs`).
+    /// the velocity gradients.
     fn grid_to_particles(&mut self, dt: f64) -> Vec<SMatrix<f64, D, D>> {
         let (kernel, transfer, stencils) = (&self.kernel, self.transfer, &self.stencils);
-        let (old_v, new_v, grad_source) = (
-            &self.grid.velocity,
-            &self.grid.new_velocity,
-            &self.grid.gradient_velocity,
-        );
+        let (old_v, new_v) = (&self.grid.velocity, &self.grid.new_velocity);
         let positions = &self.particles.position;
         let velocities = &self.particles.velocity;
         let updates: Vec<ParticleUpdate<D>> = (0..self.particles.len())
@@ -532,17 +582,25 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     let n = stencils.values[e];
                     pic += new_v[node] * n;
                     flip += (new_v[node] - old_v[node]) * n;
-                    grad_v += grad_source[node] * stencils.gradients[e].transpose();
-                    if T::USES_MOMENTS {
+                    grad_v += new_v[node] * stencils.gradients[e].transpose();
+                    if T::AFFINE {
                         let r = kernel.node_position(node) - x;
-                        b += grad_source[node] * r.transpose() * n;
                         d += r * r.transpose() * n;
+                        if T::USES_MOMENTS {
+                            b += new_v[node] * r.transpose() * n;
+                        }
                     }
                 }
+                let affine = transfer.affine(&b, &d, &grad_v);
                 ParticleUpdate {
                     velocity: transfer.velocity(&velocities[i], &pic, &flip),
                     position: x + pic * dt,
-                    affine: transfer.affine(&b, &d, &grad_v),
+                    affine_moment: if T::AFFINE {
+                        (affine * d * affine.transpose()).trace()
+                    } else {
+                        0.0
+                    },
+                    affine,
                     velocity_gradient: grad_v,
                 }
             })
@@ -554,19 +612,28 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // Work of gravity and body forces with the mean of old and new velocity: the
         // trapezoidal rule balances the kinetic energy of a free fall exactly.
         let mut power = 0.0;
+        // The longest move of the step (the position follows the PIC velocity, which for
+        // FLIP can differ from the stored one): the Courant check reads it.
+        let mut longest = (0, 0.0f64);
         for (i, update) in updates.into_iter().enumerate() {
             let acceleration =
                 body_force.map_or(gravity, |b| gravity + b(&p.position[i], self.time));
             power += p.mass[i] * acceleration.dot(&(p.velocity[i] + update.velocity)) * 0.5;
+            let moved = (update.position - p.position[i]).norm();
+            if moved > longest.1 {
+                longest = (i, moved);
+            }
             p.velocity[i] = update.velocity;
             p.position[i] = update.position;
             p.affine[i] = update.affine;
+            p.affine_moment[i] = update.affine_moment;
             if self.boundary.hold(&mut p.position[i], &mut p.velocity[i]) {
                 self.totals.wall_corrections += 1;
             }
             velocity_gradients.push(update.velocity_gradient);
         }
         self.totals.external_work += power * dt;
+        self.totals.longest_move = longest;
         velocity_gradients
     }
 
@@ -652,11 +719,17 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .enumerate()
             .fold((0, 0.0), |a, (i, s)| if s > a.1 { (i, s) } else { a });
         let max_speed = max_speed.max(0.0).sqrt();
-        let courant = max_speed * dt / self.kernel.spacing();
+        let h = self.kernel.spacing();
+        let (mover, moved) = self.totals.longest_move;
+        let (particle, courant) = if moved / h > max_speed * dt / h {
+            (mover, moved / h)
+        } else {
+            (fastest, max_speed * dt / h)
+        };
         if courant > self.settings.max_courant {
             return Err(EngineError::Unstable {
                 step,
-                particle: fastest,
+                particle,
                 courant,
                 limit: self.settings.max_courant,
             });

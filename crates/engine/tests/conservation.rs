@@ -134,16 +134,16 @@ fn leaving_the_mesh_names_the_particle() {
     particles
         .velocity
         .iter_mut()
-        .for_each(|v| *v = Vector2::new(10.0, 0.0));
+        .for_each(|v| *v = Vector2::new(4.0, 0.0));
     let mut sim = Simulation::new(
         LinearFeKernel::new(mesh()),
         material,
         Pic,
         particles,
-        StepSettings::new(1e-3),
+        StepSettings::new(5e-4),
     )
     .unwrap();
-    let error = (0..100)
+    let error = (0..1000)
         .find_map(|_| sim.step().err())
         .expect("particles leave the unit square");
     match error {
@@ -240,14 +240,10 @@ fn ill_conditioned_mls_stops_the_run() {
     let material = NeoHookean {
         parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
     };
-    let mut sim = Simulation::new(
-        Umls2::new(mesh),
-        material,
-        Pic,
-        particles,
-        StepSettings::new(1e-4),
-    )
-    .unwrap();
+    let mut settings = StepSettings::new(1e-4);
+    // The sliver's height (5·10⁻⁸) makes any Δt too large; this test is about the kernel.
+    settings.max_wave_courant = f64::INFINITY;
+    let mut sim = Simulation::new(Umls2::new(mesh), material, Pic, particles, settings).unwrap();
     let error = sim.step().unwrap_err();
     match &error {
         umls_engine::EngineError::Kernel {
