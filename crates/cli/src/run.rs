@@ -382,6 +382,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
             "wave_courant",
             "dropped_mass",
             "wall_corrections",
+            "mass_scaled_nodes",
         ]
         .map(String::from),
     );
@@ -418,6 +419,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
             d.wave_courant,
             d.dropped_mass,
             d.wall_corrections as f64,
+            d.mass_scaled_nodes as f64,
         ]);
         row.extend(error);
         history.row(&row)?;
@@ -535,6 +537,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         json!(last.redistributed_momentum.norm()),
     );
     metrics.insert("wall_corrections".into(), json!(last.wall_corrections));
+    metrics.insert("mass_scaled_nodes".into(), json!(last.mass_scaled_nodes));
     if setup.reference.is_some() && taken > 0 {
         metrics.insert(
             "velocity_rmse".into(),

@@ -8,9 +8,17 @@
 //! its outward normal velocity (and, at a fixed wall, its whole velocity). Kernels that
 //! do not interpolate (UMLS, B-splines) have a non-zero velocity at the wall even when
 //! every wall node is at rest, so the grid condition alone lets particles through.
+//!
+//! Walls given as node sets (a mesh's physical groups, curved or not) hold particles
+//! the same way through the kernel: a particle that left the mesh through a boundary
+//! facet whose nodes all carry a condition is put back on that facet.
 
 use nalgebra::SVector;
-use umls_transfer::Kernel;
+use umls_transfer::{DomainExit, Kernel};
+
+/// Per-node marks of [`Boundary::node_marks`].
+const SLIP: u8 = 1;
+const FIXED: u8 = 2;
 
 /// What a wall does to the velocity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -134,6 +142,50 @@ impl<const D: usize> Boundary<D> {
                 *v -= normal * vn;
             }
         }
+    }
+
+    /// Whether any node condition is set (walls given as node sets, such as mesh groups).
+    pub(crate) fn has_node_conditions(&self) -> bool {
+        !self.fixed.is_empty() || !self.slip.is_empty()
+    }
+
+    /// Marks per node: fixed, slip, or free.
+    pub(crate) fn node_marks(&self, nodes: usize) -> Vec<u8> {
+        let mut marks = vec![0u8; nodes];
+        for (node, _) in &self.slip {
+            marks[*node as usize] |= SLIP;
+        }
+        for &node in &self.fixed {
+            marks[node as usize] |= FIXED;
+        }
+        marks
+    }
+
+    /// A particle that left the kernel's domain through a facet whose nodes all carry a
+    /// condition has hit a wall given as a node set (a mesh group): it is put back on the
+    /// facet and loses its velocity into it (all of it when every node is fixed).
+    /// Returns whether it was moved; a particle leaving through a free facet is left to
+    /// the kernel's error.
+    pub(crate) fn hold_at_facet(
+        marks: &[u8],
+        exit: &DomainExit<D>,
+        x: &mut SVector<f64, D>,
+        v: &mut SVector<f64, D>,
+    ) -> bool {
+        let facet = exit.facet();
+        if facet.iter().any(|&n| marks[n as usize] == 0) {
+            return false;
+        }
+        *x = exit.inside;
+        if facet.iter().all(|&n| marks[n as usize] & FIXED != 0) {
+            *v = SVector::zeros();
+        } else {
+            let vn = v.dot(&exit.normal);
+            if vn > 0.0 {
+                *v -= exit.normal * vn;
+            }
+        }
+        true
     }
 
     /// Keeps a particle on the material side of every wall: a particle beyond a wall is

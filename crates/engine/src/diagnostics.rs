@@ -41,6 +41,10 @@ pub struct Diagnostics<const D: usize> {
     pub redistributed_momentum: SVector<f64, D>,
     /// How many times a particle was put back from beyond a wall.
     pub wall_corrections: usize,
+    /// Node updates that were mass-scaled (nodes beyond their own stability limit),
+    /// summed over the steps: a large count says the results near those nodes are
+    /// slowed by added inertia.
+    pub mass_scaled_nodes: usize,
 }
 
 impl<const D: usize> Diagnostics<D> {
@@ -63,6 +67,7 @@ pub(crate) struct Totals<const D: usize> {
     pub dropped_mass: f64,
     pub redistributed_momentum: SVector<f64, D>,
     pub wall_corrections: usize,
+    pub mass_scaled_nodes: usize,
     /// Kinetic plus elastic energy at the start (set before the first step).
     pub initial_energy: Option<f64>,
     /// The largest energy put in so far: initial energy plus external work.
@@ -81,6 +86,7 @@ impl<const D: usize> Default for Totals<D> {
             dropped_mass: 0.0,
             redistributed_momentum: SVector::zeros(),
             wall_corrections: 0,
+            mass_scaled_nodes: 0,
             initial_energy: None,
             energy_supplied: 0.0,
             max_speed: 0.0,

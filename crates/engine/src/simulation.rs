@@ -359,6 +359,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             dropped_mass: self.totals.dropped_mass,
             redistributed_momentum: self.totals.redistributed_momentum,
             wall_corrections: self.totals.wall_corrections,
+            mass_scaled_nodes: self.totals.mass_scaled_nodes,
         })
     }
 
@@ -454,6 +455,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         );
         self.totals.dropped_mass += report.dropped_mass;
         self.totals.redistributed_momentum += report.redistributed_momentum;
+        self.totals.mass_scaled_nodes += report.scaled_nodes;
         if let Some(node) = self
             .grid
             .new_velocity
@@ -615,6 +617,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // The longest move of the step (the position follows the PIC velocity, which for
         // FLIP can differ from the stored one): the Courant check reads it.
         let mut longest = (0, 0.0f64);
+        let marks = self
+            .boundary
+            .has_node_conditions()
+            .then(|| self.boundary.node_marks(self.grid.mass.len()));
         for (i, update) in updates.into_iter().enumerate() {
             let acceleration =
                 body_force.map_or(gravity, |b| gravity + b(&p.position[i], self.time));
@@ -629,6 +635,14 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             p.affine_moment[i] = update.affine_moment;
             if self.boundary.hold(&mut p.position[i], &mut p.velocity[i]) {
                 self.totals.wall_corrections += 1;
+            }
+            if let Some(marks) = &marks {
+                if let Some(exit) = self.kernel.domain_exit(&p.position[i], &p.cache[i]) {
+                    if Boundary::hold_at_facet(marks, &exit, &mut p.position[i], &mut p.velocity[i])
+                    {
+                        self.totals.wall_corrections += 1;
+                    }
+                }
             }
             velocity_gradients.push(update.velocity_gradient);
         }

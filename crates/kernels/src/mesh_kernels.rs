@@ -3,9 +3,9 @@
 use std::sync::Arc;
 
 use nalgebra::SVector;
-use umls_mesh::SimplexMesh;
+use umls_mesh::{Barycentric, SimplexMesh};
 use umls_mls::{GradientKind, Linear, PolynomialBasis, UmlsKernel};
-use umls_transfer::{Kernel, KernelError, Stencil};
+use umls_transfer::{DomainExit, Kernel, KernelError, Stencil};
 
 /// The node methods of a kernel whose nodes are the vertices of `self.mesh`.
 macro_rules! mesh_nodes {
@@ -23,7 +23,68 @@ macro_rules! mesh_nodes {
         fn spacing(&self) -> f64 {
             self.mesh.min_height()
         }
+
+        fn domain_exit(&self, x: &SVector<f64, D>, cache: &HostCache) -> Option<DomainExit<D>> {
+            exit(&self.mesh, x, cache)
+        }
     };
+}
+
+/// Where `x` left the mesh, seen from the cached host: a walk towards `x` from the host
+/// until it would cross a boundary facet; that facet, and the last simplex's point on it
+/// (negative barycentric coordinates clamped to zero). `None` inside the mesh (or behind
+/// a concavity, where the walk is not the way out), and before the first location.
+fn exit<const D: usize>(
+    mesh: &SimplexMesh<D>,
+    x: &SVector<f64, D>,
+    cache: &HostCache,
+) -> Option<DomainExit<D>> {
+    /// A particle moves at most about a cell per step: a few simplices of walk.
+    const MAX_STEPS: usize = 64;
+    let mut host = cache.0? as usize;
+    let mut found = None;
+    for _ in 0..MAX_STEPS {
+        let lambda = mesh.barycentric(host, x);
+        let crossed = lambda.argmin();
+        if lambda.as_slice()[crossed] >= -umls_mesh::INSIDE_TOLERANCE {
+            return None;
+        }
+        match mesh.topology().neighbor(host, crossed) {
+            Some(next) => host = next as usize,
+            None => {
+                found = Some((lambda, crossed));
+                break;
+            }
+        }
+    }
+    let (lambda, crossed) = found?;
+    if mesh.locate(x).is_some() {
+        return None;
+    }
+    let gradient = mesh.barycentric_gradients(host).as_slice()[crossed];
+    let mut coords = [0.0; 4];
+    for (c, l) in coords.iter_mut().zip(lambda.as_slice()) {
+        *c = l.max(0.0);
+    }
+    let total: f64 = coords.iter().sum();
+    coords.iter_mut().for_each(|c| *c /= total);
+    let clamped = Barycentric::<D>::from_slice(&coords[..=D])?;
+    let mut facet = [0u32; 3];
+    for (slot, &v) in facet.iter_mut().zip(
+        mesh.simplex(host)
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != crossed)
+            .map(|(_, v)| v),
+    ) {
+        *slot = v;
+    }
+    Some(DomainExit {
+        facet,
+        facet_len: D,
+        normal: -gradient / gradient.norm(),
+        inside: mesh.point_at(host, &clamped),
+    })
 }
 
 /// The host simplex a particle was last found in (`None` before the first location).

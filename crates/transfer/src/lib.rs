@@ -50,6 +50,27 @@ pub enum KernelError {
     Mls(#[from] MlsError),
 }
 
+/// Where a point left a kernel's domain: the boundary facet it crossed (its nodes), the
+/// facet's outward unit normal, and the nearest point of the last host cell on that side.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DomainExit<const D: usize> {
+    /// The facet's nodes (the first `facet_len` entries are used).
+    pub facet: [u32; 3],
+    /// How many of `facet` are used (D for a simplex facet).
+    pub facet_len: usize,
+    /// Outward unit normal of the facet.
+    pub normal: SVector<f64, D>,
+    /// A point of the domain next to where the point left it (on the crossed facet).
+    pub inside: SVector<f64, D>,
+}
+
+impl<const D: usize> DomainExit<D> {
+    /// The crossed facet's nodes.
+    pub fn facet(&self) -> &[u32] {
+        &self.facet[..self.facet_len]
+    }
+}
+
 /// A shape-function kernel over a fixed set of nodes.
 pub trait Kernel<const D: usize>: Send + Sync {
     /// Per-particle location cache (host simplex, grid cell, or `()`).
@@ -73,4 +94,12 @@ pub trait Kernel<const D: usize>: Send + Sync {
         cache: &mut Self::Cache,
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError>;
+
+    /// If `x` lies outside the domain, where it left it, seen from the location in
+    /// `cache` (`None` inside, or where the kernel cannot tell). Mesh kernels use it to
+    /// hold particles at walls given as boundary node sets. Default: `None`.
+    fn domain_exit(&self, x: &SVector<f64, D>, cache: &Self::Cache) -> Option<DomainExit<D>> {
+        let _ = (x, cache);
+        None
+    }
 }
