@@ -134,6 +134,16 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<RunReport> {
         if n == 0 {
             return Err(scene.value_error("--threads", "must be at least 1"));
         }
+        // Each thread is an OS thread with its own stack; far more threads than cores only
+        // costs time (100000 made a 50-step run never finish).
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let limit = (16 * cores).max(64);
+        if n > limit {
+            return Err(scene.value_error(
+                "--threads",
+                format!("{n} is more than {limit} (16 per core on this machine, at least 64)"),
+            ));
+        }
         pool = pool.num_threads(n);
     }
     let pool = pool

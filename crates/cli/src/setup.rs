@@ -205,8 +205,32 @@ fn material(scene: &Scene, index: usize) -> Result<Model<PlasticModel>> {
             scene.value_error(key(field), format!("required by model `{}`", m.model))
         })
     };
-    let bad = |field: &str, e: umls_constitutive::ConstitutiveError| {
-        scene.value_error(key(field), e.to_string())
+    // The key of the parameter the model rejected (not the first key of the model), with
+    // angles shown in the degrees the file gives them in.
+    let bad = |field: &str, e: umls_constitutive::ConstitutiveError| match e {
+        umls_constitutive::ConstitutiveError::InvalidParameter {
+            parameter,
+            value,
+            reason,
+        } => {
+            let (field, value) = match parameter {
+                "E (Young's modulus)" => ("young", value),
+                "ν (Poisson's ratio)" => ("poisson", value),
+                "cohesion" => ("cohesion", value),
+                "friction angle (rad)" => ("friction_angle", value.to_degrees()),
+                "dilatancy angle (rad)" => ("dilatancy_angle", value.to_degrees()),
+                "yield stress" => ("yield_stress", value),
+                "hardening modulus" => ("hardening", value),
+                "K (bulk modulus)" => ("bulk", value),
+                "γ (exponent)" => ("gamma", value),
+                _ => (field, value),
+            };
+            let reason = reason
+                .replace("[0, π/2)", "[0°, 90°)")
+                .replace("[0, friction angle]", "[0°, friction_angle]");
+            scene.value_error(key(field), format!("{value}: {reason}"))
+        }
+        other => scene.value_error(key(field), other.to_string()),
     };
     if !(m.density.is_finite() && m.density > 0.0) {
         return Err(scene.value_error(key("density"), "must be finite and positive"));
@@ -405,6 +429,24 @@ fn seed_body<const D: usize>(
                 .eval(x, 0.0)
                 .map_err(|reason| scene.value_error(key("velocity"), reason))?,
         };
+        // An infinite or undefined velocity (1/0, or 1/(x − a) at a particle on x = a)
+        // would poison the whole run.
+        if !v.iter().all(|c| c.is_finite()) {
+            let list = |u: &SVector<f64, D>| {
+                u.iter()
+                    .map(|c| format!("{c}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            return Err(scene.value_error(
+                key("velocity"),
+                format!(
+                    "is ({}) at the particle ({}): not finite",
+                    list(&v),
+                    list(x)
+                ),
+            ));
+        }
         seeds.position.push(*x);
         seeds.volume.push(*volume);
         seeds.mass.push(volume * density);

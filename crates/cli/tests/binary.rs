@@ -748,3 +748,99 @@ velocity = ["y", "-x"]
         rows[0][2]
     );
 }
+
+/// Runs `umls` with `args`, killing it after `limit` (a hang is a failure, not a stuck
+/// test suite).
+fn umls_within(args: &[&str], limit: std::time::Duration) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_umls"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            panic!("`umls {}` did not finish within {limit:?}", args.join(" "));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// Inputs that used to hang or name the wrong key: an infinite initial velocity, an
+/// absurd thread count, a Poisson ratio of 0.5, a friction angle in degrees.
+#[test]
+fn bad_values_fail_fast_and_name_their_key() {
+    let dir = scratch("bad-values");
+    std::fs::create_dir_all(&dir).unwrap();
+    let disks = umls_cli::builtin::BUILTIN[0].toml;
+    let run = |name: &str, text: String, extra: &[&str]| {
+        let file = dir.join(format!("{name}.toml"));
+        std::fs::write(&file, text).unwrap();
+        let out_dir = dir.join(name);
+        let mut args = vec![
+            "run",
+            file.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--quiet",
+        ];
+        args.extend(extra);
+        let out = umls_within(&args, std::time::Duration::from_secs(60));
+        assert!(!out.status.success(), "{name} succeeded");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let err = run(
+        "infinite-velocity",
+        disks.replacen("velocity = [0.1, 0.1]", "velocity = [\"1 / 0\", \"0\"]", 1),
+        &[],
+    );
+    assert!(
+        err.contains("bodies[0].velocity") && err.contains("not finite"),
+        "{err}"
+    );
+    let err = run(
+        "singular-velocity",
+        disks.replacen(
+            "velocity = [0.1, 0.1]",
+            "velocity = [\"1 / (x - 0.2125)\", \"0\"]",
+            1,
+        ),
+        &[],
+    );
+    // At a particle exactly on x = a it is infinite (the key's error); a particle a
+    // rounding error away gets 10¹⁷ m/s, which the stable-step check stops at once.
+    assert!(
+        err.contains("bodies[0].velocity") || err.contains("exceeds the stable step"),
+        "{err}"
+    );
+    let err = run("threads", disks.to_string(), &["--threads", "100000"]);
+    assert!(err.contains("--threads") && err.contains("100000"), "{err}");
+    let err = run(
+        "poisson",
+        disks.replacen("poisson = 0.3", "poisson = 0.5", 1),
+        &[],
+    );
+    assert!(
+        err.contains("materials[0].poisson") && err.contains("0.5"),
+        "{err}"
+    );
+    assert!(!err.contains("materials[0].young"), "{err}");
+    let err = run(
+        "friction",
+        disks.replacen(
+            "model = \"linear-elastic\"",
+            "model = \"drucker-prager\"\ncohesion = 10.0\nfriction_angle = 95.0",
+            1,
+        ),
+        &[],
+    );
+    // The angle as given, in degrees, under its own key.
+    assert!(
+        err.contains("materials[0].friction_angle") && err.contains("95"),
+        "{err}"
+    );
+    assert!(err.contains("90°") && !err.contains("1.658"), "{err}");
+}
