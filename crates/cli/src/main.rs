@@ -26,7 +26,8 @@ enum Command {
         /// Shape-function kernel (default: the scene's).
         #[arg(long, value_enum)]
         kernel: Option<KernelKind>,
-        /// Output directory (default: out/<scene name>).
+        /// Output directory (default: out/<scene name>-<kernel>); the files of an earlier run
+        /// there are replaced.
         #[arg(long)]
         out: Option<PathBuf>,
         /// Simulated time (default: the scene's).
@@ -66,7 +67,11 @@ fn main() -> ExitCode {
             threads,
             quiet,
         } => Scene::load(&scene).and_then(|scene| {
-            let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene.spec.scene.name));
+            // One folder per scene and kernel, so comparisons do not overwrite each other.
+            let kernel_name = kernel.unwrap_or(scene.spec.kernel.kind).name();
+            let out = out.unwrap_or_else(|| {
+                PathBuf::from("out").join(format!("{}-{kernel_name}", scene.spec.scene.name))
+            });
             let options = RunOptions {
                 kernel,
                 out,

@@ -29,12 +29,24 @@ impl OutputDir {
             path: dir.to_path_buf(),
             source,
         })?;
+        clear_previous_run(dir)?;
         Ok(Self {
             dir: dir.to_path_buf(),
             encoding,
             collection: Collection::default(),
         })
     }
+
+    /// Names of the files a run writes (frames are `particles_NNNNN.vtu`).
+    pub const OWNED: [&'static str; 7] = [
+        "particles.pvd",
+        "mesh.vtu",
+        "grid.vtu",
+        "history.csv",
+        "summary.json",
+        "energies.svg",
+        "particles_*.vtu",
+    ];
 
     /// A path inside the directory.
     pub fn path(&self, name: &str) -> PathBuf {
@@ -167,4 +179,29 @@ impl OutputDir {
         grid.write_vtu(self.path("grid.vtu"), self.encoding)?;
         Ok(())
     }
+}
+
+/// Removes what an earlier run wrote into `dir` (the files of [`OutputDir::OWNED`], and
+/// nothing else): a 3-frame run into a folder that held 61 frames would otherwise leave 58
+/// stale frames that ParaView loads as one series, and a B-spline run's `grid.vtu` would
+/// outlive it.
+fn clear_previous_run(dir: &Path) -> Result<()> {
+    let entries = std::fs::read_dir(dir).map_err(|source| CliError::File {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else { continue };
+        let frame = name
+            .strip_prefix("particles_")
+            .and_then(|r| r.strip_suffix(".vtu"));
+        let owned = OutputDir::OWNED[..6].contains(&name)
+            || frame.is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()));
+        if owned && entry.file_type().is_ok_and(|t| t.is_file()) {
+            let path = entry.path();
+            std::fs::remove_file(&path).map_err(|source| CliError::File { path, source })?;
+        }
+    }
+    Ok(())
 }

@@ -844,3 +844,49 @@ fn bad_values_fail_fast_and_name_their_key() {
     );
     assert!(err.contains("90°") && !err.contains("1.658"), "{err}");
 }
+
+/// A run replaces what an earlier run left in its folder (stale frames, a B-spline
+/// run's grid.vtu) and nothing else.
+#[test]
+fn a_run_clears_the_files_of_an_earlier_run() {
+    let dir = scratch("stale");
+    std::fs::create_dir_all(&dir).unwrap();
+    for stale in ["particles_00099.vtu", "grid.vtu", "summary.json"] {
+        std::fs::write(dir.join(stale), "stale").unwrap();
+    }
+    std::fs::write(dir.join("notes.txt"), "mine").unwrap();
+    std::fs::write(dir.join("particles_final.vtu"), "mine too").unwrap();
+    let out = umls(&[
+        "run",
+        "vibrating-bar",
+        "--kernel",
+        "linear-fe",
+        "--end-time",
+        "0.05",
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(!dir.join("particles_00099.vtu").exists());
+    assert!(!dir.join("grid.vtu").exists());
+    assert_eq!(
+        std::fs::read_to_string(dir.join("notes.txt")).unwrap(),
+        "mine"
+    );
+    assert!(dir.join("particles_final.vtu").exists());
+    let listed = frames(&dir).len();
+    let written = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter(|e| {
+            let name = e.as_ref().unwrap().file_name().into_string().unwrap();
+            name.starts_with("particles_0") && name.ends_with(".vtu")
+        })
+        .count();
+    assert_eq!(listed, written);
+    assert_eq!(summary(&dir)["status"], "completed");
+}
