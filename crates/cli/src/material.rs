@@ -167,6 +167,19 @@ impl<const D: usize, P: PlasticPart<D>> Constitutive<D> for MaterialTable<P> {
         }
     }
 
+    fn out_of_plane_stress(
+        &self,
+        f: &SMatrix<f64, D, D>,
+        state: &Self::State,
+    ) -> Result<f64, ConstitutiveError> {
+        match self.get(state.material)? {
+            Model::Elastic(m) => {
+                elastic_dispatch!(m, m => Constitutive::<D>::out_of_plane_stress(m, f, &()))
+            }
+            Model::Plastic(p) => p.model().out_of_plane_stress(f, &state.plastic),
+        }
+    }
+
     fn energy_density(
         &self,
         f: &SMatrix<f64, D, D>,

@@ -86,18 +86,41 @@ impl OutputDir {
             .iter()
             .map(umls_constitutive::determinant)
             .collect();
-        let cauchy: Vec<_> = kirchhoff
+        // Full 3×3 tensors: in 2D the plane-strain σ_zz (not zero) and F_zz = 1; in 1D
+        // (uniaxial stress) σ_yy = σ_zz = 0 and the unknown lateral stretches shown as 1.
+        let mut cauchy = Vec::with_capacity(9 * p.len());
+        let mut mean = Vec::with_capacity(p.len());
+        for (i, ((tau, j), (f, state))) in kirchhoff
             .iter()
             .zip(&jacobian)
-            .map(|(t, j)| t / *j)
+            .zip(p.deformation.iter().zip(&p.state))
+            .enumerate()
+        {
+            let zz = if D == 2 {
+                let tau_zz = sim
+                    .material
+                    .out_of_plane_stress(f, state)
+                    .map_err(|source| umls_engine::EngineError::Material {
+                        step: sim.step_count(),
+                        particle: i,
+                        source,
+                    })?;
+                tau_zz / j
+            } else {
+                0.0
+            };
+            let sigma = full_tensor(&(tau / *j), zz);
+            mean.push((sigma[0] + sigma[4] + sigma[8]) / 3.0);
+            cauchy.extend(sigma);
+        }
+        grid.add_point_field("cauchy_stress", 9, cauchy)?;
+        grid.add_point_field("mean_stress", 1, mean)?;
+        let deformation = p
+            .deformation
+            .iter()
+            .flat_map(|f| full_tensor(f, 1.0))
             .collect();
-        grid.add_point_tensors("cauchy_stress", &cauchy)?;
-        grid.add_point_field(
-            "mean_stress",
-            1,
-            cauchy.iter().map(|s| s.trace() / D as f64).collect(),
-        )?;
-        grid.add_point_tensors("deformation_gradient", &p.deformation)?;
+        grid.add_point_field("deformation_gradient", 9, deformation)?;
         grid.add_point_field("jacobian", 1, jacobian)?;
         grid.add_point_field("mass", 1, p.mass.clone())?;
         grid.add_point_ids(
@@ -204,4 +227,18 @@ fn clear_previous_run(dir: &Path) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// A D×D tensor as a row-major 3×3 one, with `rest` on the diagonal entries beyond D.
+fn full_tensor<const D: usize>(m: &nalgebra::SMatrix<f64, D, D>, rest: f64) -> [f64; 9] {
+    std::array::from_fn(|k| {
+        let (i, j) = (k / 3, k % 3);
+        if i < D && j < D {
+            m[(i, j)]
+        } else if i == j {
+            rest
+        } else {
+            0.0
+        }
+    })
 }

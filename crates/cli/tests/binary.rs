@@ -890,3 +890,53 @@ fn a_run_clears_the_files_of_an_earlier_run() {
     assert_eq!(listed, written);
     assert_eq!(summary(&dir)["status"], "completed");
 }
+
+/// 2D output carries the plane-strain state: F_zz = 1, σ_zz = ν (σ_xx + σ_yy) for linear
+/// elasticity, and mean_stress = tr σ / 3 with that σ_zz.
+#[test]
+fn two_dimensional_tensors_are_plane_strain() {
+    let dir = scratch("plane-strain");
+    let out = umls(&[
+        "run",
+        "colliding-disks",
+        "--end-time",
+        "1.0",
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (_, last) = frames(&dir).pop().unwrap();
+    let (n, arrays) = point_arrays(&dir.join(last));
+    let get = |name: &str| &arrays.iter().find(|(a, _)| a == name).unwrap().1;
+    let (sigma, f, mean) = (
+        get("cauchy_stress"),
+        get("deformation_gradient"),
+        get("mean_stress"),
+    );
+    let mut loaded = 0;
+    for p in 0..n {
+        let s = &sigma[9 * p..9 * p + 9];
+        assert_eq!(f[9 * p + 8], 1.0);
+        assert_eq!(
+            (f[9 * p + 2], f[9 * p + 5], f[9 * p + 6], f[9 * p + 7]),
+            (0.0, 0.0, 0.0, 0.0)
+        );
+        let in_plane = s[0] + s[4];
+        assert!(
+            (s[8] - 0.3 * in_plane).abs() <= 1e-12 * in_plane.abs().max(1e-300),
+            "{s:?}"
+        );
+        assert!(
+            (mean[p] - (s[0] + s[4] + s[8]) / 3.0).abs()
+                <= 1e-12 * s[0].abs().max(s[4].abs()).max(1e-300)
+        );
+        loaded += usize::from(s[8] != 0.0);
+    }
+    // At t = 1 the disks are in contact: stressed particles exist.
+    assert!(loaded > n / 10, "{loaded} of {n}");
+}

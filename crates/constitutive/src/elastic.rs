@@ -43,6 +43,15 @@ impl<const D: usize> Constitutive<D> for LinearElastic {
         Ok(sigma * determinant(f))
     }
 
+    fn out_of_plane_stress(&self, f: &Matrix<D>, _: &()) -> Result<f64, ConstitutiveError> {
+        if D != 2 {
+            return Ok(0.0);
+        }
+        finite(Self::NAME, f)?;
+        let (lambda, _) = self.parameters.for_dimension(D);
+        Ok(lambda * small_strain(f).trace() * determinant(f))
+    }
+
     fn energy_density(&self, f: &Matrix<D>, _: &()) -> Result<f64, ConstitutiveError> {
         finite(Self::NAME, f)?;
         let (lambda, mu) = self.parameters.for_dimension(D);
@@ -82,6 +91,15 @@ impl<const D: usize> Constitutive<D> for NeoHookean {
         let (lambda, mu) = self.parameters.for_dimension(D);
         Ok((f * f.transpose() - Matrix::<D>::identity()) * mu
             + Matrix::<D>::identity() * (lambda * j.ln()))
+    }
+
+    fn out_of_plane_stress(&self, f: &Matrix<D>, _: &()) -> Result<f64, ConstitutiveError> {
+        if D != 2 {
+            return Ok(0.0);
+        }
+        let j = positive_jacobian(Self::NAME, f)?;
+        let (lambda, _) = self.parameters.for_dimension(D);
+        Ok(lambda * j.ln())
     }
 
     fn energy_density(&self, f: &Matrix<D>, _: &()) -> Result<f64, ConstitutiveError> {
@@ -132,6 +150,15 @@ impl<const D: usize> Constitutive<D> for StVenantKirchhoff {
         Ok(f * s * f.transpose())
     }
 
+    fn out_of_plane_stress(&self, f: &Matrix<D>, _: &()) -> Result<f64, ConstitutiveError> {
+        if D != 2 {
+            return Ok(0.0);
+        }
+        finite(Self::NAME, f)?;
+        let (lambda, _) = self.parameters.for_dimension(D);
+        Ok(lambda * Self::green_strain(f).trace())
+    }
+
     fn energy_density(&self, f: &Matrix<D>, _: &()) -> Result<f64, ConstitutiveError> {
         finite(Self::NAME, f)?;
         let (lambda, mu) = self.parameters.for_dimension(D);
@@ -175,6 +202,16 @@ impl<const D: usize> Constitutive<D> for FixedCorotated {
         let j = determinant(f);
         Ok((f - rotation) * f.transpose() * (2.0 * mu)
             + Matrix::<D>::identity() * (lambda * (j - 1.0) * j))
+    }
+
+    fn out_of_plane_stress(&self, f: &Matrix<D>, _: &()) -> Result<f64, ConstitutiveError> {
+        if D != 2 {
+            return Ok(0.0);
+        }
+        finite(Self::NAME, f)?;
+        let (lambda, _) = self.parameters.for_dimension(D);
+        let j = determinant(f);
+        Ok(lambda * (j - 1.0) * j)
     }
 
     fn energy_density(&self, f: &Matrix<D>, _: &()) -> Result<f64, ConstitutiveError> {

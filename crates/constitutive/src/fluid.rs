@@ -58,6 +58,14 @@ impl<const D: usize> Constitutive<D> for WeaklyCompressibleFluid {
         Ok(Matrix::<D>::identity() * (-j * self.pressure(j)))
     }
 
+    fn out_of_plane_stress(&self, f: &Matrix<D>, _: &()) -> Result<f64, ConstitutiveError> {
+        if D != 2 {
+            return Ok(0.0);
+        }
+        let j = positive_jacobian(Self::NAME, f)?;
+        Ok(-j * self.pressure(j))
+    }
+
     fn energy_density(&self, f: &Matrix<D>, _: &()) -> Result<f64, ConstitutiveError> {
         let j = positive_jacobian(Self::NAME, f)?;
         let k = self.bulk;

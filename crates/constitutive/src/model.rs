@@ -36,6 +36,19 @@ pub trait Constitutive<const D: usize>: Send + Sync + Debug {
         state: &Self::State,
     ) -> Result<Matrix<D>, ConstitutiveError>;
 
+    /// The out-of-plane Kirchhoff stress τ_zz of a 2D (plane-strain) model, where F_zz = 1
+    /// but τ_zz is not zero (λ ln J for neo-Hookean). Zero in 1D (uniaxial stress) and 3D
+    /// (where τ has all its components). Default: zero, the plane-stress answer; plane-
+    /// strain models override it.
+    fn out_of_plane_stress(
+        &self,
+        f: &Matrix<D>,
+        state: &Self::State,
+    ) -> Result<f64, ConstitutiveError> {
+        let _ = (f, state);
+        Ok(0.0)
+    }
+
     /// Stored (elastic) energy per unit reference volume, ψ(F).
     fn energy_density(&self, f: &Matrix<D>, state: &Self::State) -> Result<f64, ConstitutiveError>;
 

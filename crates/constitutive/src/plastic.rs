@@ -220,6 +220,17 @@ impl<const D: usize, Y: YieldCriterion> Constitutive<D> for ElastoPlastic<Y> {
         Ok(e.u * Matrix::<D>::from_diagonal(&diag) * e.u.transpose())
     }
 
+    fn out_of_plane_stress(
+        &self,
+        f: &Matrix<D>,
+        state: &PlasticState<D>,
+    ) -> Result<f64, ConstitutiveError> {
+        if D != 2 {
+            return Ok(0.0);
+        }
+        Ok(self.principal_stress(f, state)?[2])
+    }
+
     fn energy_density(
         &self,
         f: &Matrix<D>,

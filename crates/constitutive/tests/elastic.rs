@@ -320,3 +320,56 @@ fn parameter_and_deformation_errors() {
         "{message}"
     );
 }
+
+/// The out-of-plane stress of a plane-strain model is the τ_zz of the same model in 3D
+/// with F_zz = 1, for every model (and zero in 1D and 3D, where it has no meaning).
+#[test]
+fn out_of_plane_stress_is_the_3d_models_zz_component() {
+    let parameters = ElasticParameters::from_young_poisson(2e6, 0.3).unwrap();
+    let f2 = Matrix2::new(1.05, 0.08, -0.03, 0.93);
+    let f3 = Matrix3::new(1.05, 0.08, 0.0, -0.03, 0.93, 0.0, 0.0, 0.0, 1.0);
+    fn check<M: Constitutive<2, State = ()> + Constitutive<3, State = ()>>(
+        model: &M,
+        f2: &Matrix2<f64>,
+        f3: &Matrix3<f64>,
+    ) {
+        let zz = Constitutive::<2>::out_of_plane_stress(model, f2, &()).unwrap();
+        let tau = Constitutive::<3>::kirchhoff_stress(model, f3, &()).unwrap();
+        assert!(
+            (zz - tau[(2, 2)]).abs() < 1e-9 * tau.amax(),
+            "{}: {zz} vs {}",
+            Constitutive::<2>::name(model),
+            tau[(2, 2)]
+        );
+        assert!(zz.abs() > 0.0);
+        assert_eq!(
+            Constitutive::<3>::out_of_plane_stress(model, f3, &()).unwrap(),
+            0.0
+        );
+    }
+    check(&LinearElastic { parameters }, &f2, &f3);
+    check(&NeoHookean { parameters }, &f2, &f3);
+    check(&StVenantKirchhoff { parameters }, &f2, &f3);
+    check(&FixedCorotated { parameters }, &f2, &f3);
+    check(&WeaklyCompressibleFluid::new(1e6, 7.0).unwrap(), &f2, &f3);
+    // Plastic models, elastic state: the Hencky stress's out-of-plane principal value.
+    let dp = ElastoPlastic::new(
+        parameters,
+        DruckerPrager::from_mohr_coulomb(1e9, 0.5, 0.0, ConeFit::PlaneStrain).unwrap(),
+    );
+    let vm = ElastoPlastic::new(parameters, VonMises::new(1e9, 0.0).unwrap());
+    let zz =
+        Constitutive::<2>::out_of_plane_stress(&dp, &f2, &Constitutive::<2>::initial_state(&dp))
+            .unwrap();
+    let tau = Constitutive::<3>::kirchhoff_stress(&dp, &f3, &Constitutive::<3>::initial_state(&dp))
+        .unwrap();
+    assert!(
+        (zz - tau[(2, 2)]).abs() < 1e-9 * tau.amax(),
+        "{zz} vs {}",
+        tau[(2, 2)]
+    );
+    let zz =
+        Constitutive::<2>::out_of_plane_stress(&vm, &f2, &Constitutive::<2>::initial_state(&vm))
+            .unwrap();
+    assert!((zz - tau[(2, 2)]).abs() < 1e-9 * tau.amax());
+}
