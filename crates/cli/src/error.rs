@@ -40,6 +40,14 @@ pub enum CliError {
     /// A generated mesh is invalid.
     #[error("mesh: {0}")]
     Mesh(#[from] umls_mesh::MeshError),
+    /// The run was interrupted (Ctrl-C); its output up to then is written.
+    #[error("interrupted at t = {time} (step {step}); the output up to then is written")]
+    Interrupted {
+        /// Simulated time reached.
+        time: f64,
+        /// Steps taken.
+        step: usize,
+    },
     /// The simulation stopped.
     #[error("simulation stopped: {0}")]
     Engine(#[from] umls_engine::EngineError),

@@ -8,8 +8,9 @@
 //!
 //! Dependencies beyond the workspace's: `clap` (argument parsing and `--help`),
 //! `indicatif` (progress bar), `plotters` (the energy plot), `toml` + `serde` (scene files, with unknown keys
-//! rejected), `serde_json` (the run summary) and `exmex` (velocity expressions such as
-//! `"0.1 * sin(PI * x / 50)"`): each a maintained crate that does its job better than a
+//! rejected), `serde_json` (the run summary), `exmex` (velocity expressions such as
+//! `"0.1 * sin(PI * x / 50)"`) and `ctrlc` (Ctrl-C ends a run with its output written,
+//! portably across platforms): each a maintained crate that does its job better than a
 //! hand-written one would.
 //!
 //! ```
@@ -18,7 +19,7 @@
 //!
 //! let scene = Scene::load("vibrating-bar")?;
 //! let out = std::env::temp_dir().join("umls-doc-bar");
-//! let options = RunOptions { kernel: None, out: out.clone(), end_time: Some(0.5), threads: Some(1), progress: false };
+//! let options = RunOptions { kernel: None, out: out.clone(), end_time: Some(0.5), threads: Some(1), progress: false, interrupt: None };
 //! let report = run(&scene, &options)?;
 //! assert_eq!(report.summary["status"], "completed");
 //! assert!(report.summary["metrics"]["velocity_rmse"].as_f64().unwrap() < 1e-3);

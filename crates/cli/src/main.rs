@@ -72,12 +72,22 @@ fn main() -> ExitCode {
             let out = out.unwrap_or_else(|| {
                 PathBuf::from("out").join(format!("{}-{kernel_name}", scene.spec.scene.name))
             });
+            // Ctrl-C stops the run after the current step and still writes its output
+            // and summary; a second Ctrl-C (or a failed handler) ends the process as usual.
+            let interrupt = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+            let flag = interrupt.clone();
+            let handler = ctrlc::set_handler(move || {
+                if flag.swap(true, std::sync::atomic::Ordering::Relaxed) {
+                    std::process::exit(130);
+                }
+            });
             let options = RunOptions {
                 kernel,
                 out,
                 end_time,
                 threads,
                 progress: !quiet,
+                interrupt: handler.is_ok().then_some(interrupt),
             };
             let report = run(&scene, &options)?;
             let s = &report.summary;

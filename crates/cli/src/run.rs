@@ -42,6 +42,9 @@ pub struct RunOptions {
     pub threads: Option<usize>,
     /// Show a progress bar.
     pub progress: bool,
+    /// Set (by a Ctrl-C handler) to stop the run after the current step; the output up to
+    /// then is written and the summary says "interrupted".
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// What a finished run reports.
@@ -478,6 +481,18 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         if let TimeStepControl::Adaptive { .. } = sim.settings.time_step {
             sim.settings.dt = dt_cap.min(ctx.end_time - sim.time());
         }
+        if ctx
+            .options
+            .interrupt
+            .as_ref()
+            .is_some_and(|flag| flag.load(std::sync::atomic::Ordering::Relaxed))
+        {
+            failure = Some(CliError::Interrupted {
+                time: sim.time(),
+                step: sim.step_count(),
+            });
+            break;
+        }
         if let Err(e) = sim.step() {
             failure = Some(e.into());
             break;
@@ -505,6 +520,16 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     }
     let wall = start.elapsed().as_secs_f64();
     progress.finish();
+    if failure.is_some() {
+        // The state the run stopped in (the last frame may be far behind it), and its
+        // history row.
+        out.write_particles(&sim, &reference_positions)?;
+        if let Ok((total, d, r)) = record(&sim, &mut history, None) {
+            energies.push(r);
+            last_total = total;
+            last = d;
+        }
+    }
     history.flush()?;
     let (mass, velocity) = sim.grid();
     if mesh_kernel {
@@ -579,7 +604,11 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         "steps_planned": steps,
         "steps": taken,
         "threads": rayon::current_num_threads(),
-        "status": if failure.is_some() { "failed" } else { "completed" },
+        "status": match &failure {
+            None => "completed",
+            Some(CliError::Interrupted { .. }) => "interrupted",
+            Some(_) => "failed",
+        },
         "error": failure.as_ref().map(|e| e.to_string()),
         "wall_time_s": wall,
         "particle_steps_per_second": if wall > 0.0 { (sim.particles.len() * taken) as f64 / wall } else { 0.0 },

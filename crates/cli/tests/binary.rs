@@ -474,6 +474,64 @@ fn an_unstable_run_leaves_its_history_and_says_why() {
     // before the run, and in the summary.
     assert!(err.contains("warning: time.dt"), "{err}");
     assert_eq!(s["dt_exceeds_stable"], true);
+    // The state the run stopped in is the last frame.
+    let (time, _) = frames(&dir.join("out")).pop().unwrap();
+    let stopped = rows.last().unwrap()[1];
+    assert_eq!(time, stopped);
+}
+
+/// Ctrl-C (SIGINT) stops a run after the current step and still writes the last state,
+/// the mesh, the plot and a summary saying "interrupted".
+#[test]
+fn an_interrupted_run_writes_its_output() {
+    let dir = scratch("interrupted");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_umls"))
+        .args([
+            "run",
+            "cantilever",
+            "--end-time",
+            "100",
+            "--out",
+            dir.to_str().unwrap(),
+            "--quiet",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait until the run is stepping (its first frame is written), then interrupt it.
+    let start = std::time::Instant::now();
+    while !dir.join("particles_00000.vtu").exists() {
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(60),
+            "the run never started"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > std::time::Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("the interrupted run did not stop");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("interrupted at t ="));
+    let s = summary(&dir);
+    assert_eq!(s["status"], "interrupted");
+    assert!(s["steps"].as_u64().unwrap() > 0);
+    for file in ["mesh.vtu", "energies.svg", "history.csv"] {
+        assert!(dir.join(file).exists(), "{file}");
+    }
+    assert!(frames(&dir).len() >= 2);
 }
 
 /// The quasi-static keys: a soft column on slip planes, loaded by a gravity ramp, damped,

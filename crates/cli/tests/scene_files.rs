@@ -17,6 +17,7 @@ fn options(name: &str, end_time: Option<f64>) -> RunOptions {
         end_time,
         threads: Some(2),
         progress: false,
+        interrupt: None,
     }
 }
 
@@ -169,7 +170,7 @@ fn bad_values_name_their_key() {
             "colliding-disks",
             "poisson = 0.3",
             "poisson = 0.5",
-            "`materials[0].young`",
+            "`materials[0].poisson`",
         ),
         (
             "colliding-disks",
