@@ -308,7 +308,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         sim.set_geostatic_stress(k0)?;
     }
 
-    let mut warnings = Vec::new();
+    let mut warnings = setup.warnings.clone();
     let stable_dt = sim.stable_time_step(1.0);
     let target_dt = match (spec.time.dt, spec.time.cfl, spec.time.adaptive) {
         (_, Some(cfl), true) => {
@@ -322,7 +322,19 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         (_, Some(cfl), _) => sim.stable_time_step(cfl),
         _ => unreachable_dt(scene)?,
     };
-    let steps = ((ctx.end_time / target_dt) - 1e-9).ceil().max(1.0) as usize;
+    let planned = ((ctx.end_time / target_dt) - 1e-9).ceil().max(1.0);
+    // A typo in end_time (1e12 for 1.2) should be an error, not a run of years.
+    const MAX_STEPS: f64 = 1e9;
+    if planned > MAX_STEPS {
+        return Err(scene.value_error(
+            "scene.end_time",
+            format!(
+                "{} with a time step of {target_dt:.4e} is {planned:.3e} steps (limit {MAX_STEPS:.0e})",
+                ctx.end_time
+            ),
+        ));
+    }
+    let steps = planned as usize;
     let dt_cap = match sim.settings.time_step {
         TimeStepControl::Adaptive { .. } => spec.time.dt.unwrap_or(ctx.end_time),
         TimeStepControl::Fixed => ctx.end_time / steps as f64,

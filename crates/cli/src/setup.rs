@@ -81,6 +81,8 @@ pub struct Setup<const D: usize> {
     pub damping: Damping,
     /// Geostatic K0, if the particles start with their geostatic stress.
     pub geostatic_k0: Option<f64>,
+    /// What the user should hear about the setup (a body clipped by the mesh, …).
+    pub warnings: Vec<String>,
     /// The analytic velocity v(X, t), and the scale its RMSE is divided by.
     pub reference: Option<(VectorField<D>, f64)>,
 }
@@ -323,7 +325,7 @@ fn seed_body<const D: usize>(
     groups: &[PhysicalGroup],
     material: u16,
     seeds: &mut Seeds<D>,
-) -> Result<()> {
+) -> Result<Option<String>> {
     let body = &scene.spec.bodies[index];
     let key = |field: &str| format!("bodies[{index}].{field}");
     let density = scene.spec.materials[material as usize].density;
@@ -384,7 +386,12 @@ fn seed_body<const D: usize>(
                     format!("spacing {h} puts {count:.3e} lattice points over the mesh (limit {MAX_LATTICE_POINTS:.0e})"),
                 ));
             }
+            // Lattice points over the bounding box; those outside the mesh itself (a
+            // non-convex Gmsh domain) would stop the run at its first step.
             lattice_samples(lower, upper, *h)
+                .into_iter()
+                .filter(|(x, _)| mesh.locate(x).is_some())
+                .collect()
         }
         SeedingSpec::Mesh(rule) => {
             let rule = match rule.as_str() {
@@ -456,7 +463,23 @@ fn seed_body<const D: usize>(
     if seeds.position.len() == before {
         return Err(scene.value_error(key("region"), "the region holds no particle"));
     }
-    Ok(())
+    // A box or ball partly outside the mesh is clipped to it: say so.
+    let expected = match &region {
+        Region::Box { lower, upper } => Some((upper - lower).iter().product::<f64>()),
+        Region::Ball { radius, .. } => Some(match D {
+            1 => 2.0 * radius,
+            2 => std::f64::consts::PI * radius * radius,
+            _ => 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3),
+        }),
+        _ => None,
+    };
+    let seeded: f64 = seeds.volume[before..].iter().sum();
+    Ok(expected.filter(|v| seeded < 0.9 * v).map(|v| {
+        format!(
+            "bodies[{index}]: the region's volume is {v:.4}, its particles fill {seeded:.4} ({:.0} %): part of it lies outside the mesh and was left out",
+            100.0 * seeded / v
+        )
+    }))
 }
 
 /// Builds the D-dimensional setup of `scene`.
@@ -466,6 +489,7 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
     if spec.materials.is_empty() {
         return Err(scene.value_error("materials", "at least one material is needed"));
     }
+    let mut warnings = Vec::new();
     if spec.materials.len() > usize::from(u16::MAX) {
         return Err(scene.value_error("materials", "too many materials"));
     }
@@ -491,7 +515,14 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
                     ),
                 )
             })?;
-        seed_body(scene, i, &mesh, &groups, material as u16, &mut seeds)?;
+        warnings.extend(seed_body(
+            scene,
+            i,
+            &mesh,
+            &groups,
+            material as u16,
+            &mut seeds,
+        )?);
     }
     let mut boundaries = Vec::new();
     for (i, b) in spec.boundaries.iter().enumerate() {
@@ -618,6 +649,7 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
         gravity_ramp,
         damping,
         geostatic_k0,
+        warnings,
         reference,
     })
 }

@@ -887,6 +887,15 @@ fn bad_values_fail_fast_and_name_their_key() {
     );
     assert!(!err.contains("materials[0].young"), "{err}");
     let err = run(
+        "end-time",
+        disks.replacen("end_time = 3.0", "end_time = 1e12", 1),
+        &[],
+    );
+    assert!(
+        err.contains("scene.end_time") && err.contains("steps"),
+        "{err}"
+    );
+    let err = run(
         "friction",
         disks.replacen(
             "model = \"linear-elastic\"",
@@ -901,6 +910,46 @@ fn bad_values_fail_fast_and_name_their_key() {
         "{err}"
     );
     assert!(err.contains("90°") && !err.contains("1.658"), "{err}");
+}
+
+/// A body partly outside the mesh is clipped with a warning that says how much.
+#[test]
+fn a_clipped_body_is_reported() {
+    let dir = scratch("clipped");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("clipped.toml");
+    let text = umls_cli::builtin::BUILTIN[0].toml.replacen(
+        "centre = [0.2, 0.2], radius = 0.2",
+        "centre = [0.0, 0.2], radius = 0.2",
+        1,
+    );
+    std::fs::write(&file, text).unwrap();
+    let out = umls(&[
+        "run",
+        file.to_str().unwrap(),
+        "--end-time",
+        "0.01",
+        "--out",
+        dir.join("out").to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("warning: bodies[0]") && err.contains("outside the mesh"),
+        "{err}"
+    );
+    let s = summary(&dir.join("out"));
+    let warnings = s["warnings"].as_array().unwrap();
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("bodies[0]"))
+    );
 }
 
 /// A run replaces what an earlier run left in its folder (stale frames, a B-spline
