@@ -38,6 +38,14 @@ impl Scene {
             return Self::parse(builtin.toml, builtin.name, None);
         }
         let path = Path::new(name_or_path);
+        if path.is_dir() {
+            return Err(CliError::File {
+                path: path.to_path_buf(),
+                source: std::io::Error::other(
+                    "is a directory; give a scene file (.toml) or a built-in scene name",
+                ),
+            });
+        }
         if !path.is_file() {
             return Err(CliError::UnknownScene {
                 name: name_or_path.to_string(),

@@ -887,6 +887,24 @@ fn bad_values_fail_fast_and_name_their_key() {
     );
     assert!(!err.contains("materials[0].young"), "{err}");
     let err = run(
+        "jitter",
+        disks.replacen("jitter = 0.2", "jitter = 0.5", 1),
+        &[],
+    );
+    assert!(
+        err.contains("jitter") && err.contains("[0, 0.2]") && !err.contains("MAX_JITTER"),
+        "{err}"
+    );
+    let out = umls_within(
+        &["run", dir.to_str().unwrap()],
+        std::time::Duration::from_secs(60),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("is a directory"),
+        "{err}"
+    );
+    let err = run(
         "end-time",
         disks.replacen("end_time = 3.0", "end_time = 1e12", 1),
         &[],

@@ -161,7 +161,7 @@ impl<const D: usize> Lattice<D> {
             return bad(
                 "jitter",
                 self.jitter.to_string(),
-                "must lie in [0, MAX_JITTER = 0.2]",
+                "must lie in [0, 0.2] (a fraction of the cell width; more can invert cells)",
             );
         }
         let r = &self.rotation;
