@@ -39,6 +39,19 @@ macro_rules! elastic_dispatch {
     };
 }
 
+/// Calls `$method(f, state)` on the model of a particle's material: elastic models with
+/// the unit state, plastic ones with the particle's plastic state.
+macro_rules! per_material {
+    ($table:expr, $method:ident, $f:expr, $state:expr) => {
+        match $table.get($state.material)? {
+            Model::Elastic(m) => {
+                elastic_dispatch!(m, m => Constitutive::<D>::$method(m, $f, &()))
+            }
+            Model::Plastic(p) => p.model().$method($f, &$state.plastic),
+        }
+    };
+}
+
 /// Plastic models (D = 2 plane strain, D = 3).
 #[derive(Debug, Clone)]
 pub enum PlasticModel {
@@ -159,12 +172,7 @@ impl<const D: usize, P: PlasticPart<D>> Constitutive<D> for MaterialTable<P> {
         f: &SMatrix<f64, D, D>,
         state: &Self::State,
     ) -> Result<SMatrix<f64, D, D>, ConstitutiveError> {
-        match self.get(state.material)? {
-            Model::Elastic(m) => {
-                elastic_dispatch!(m, m => Constitutive::<D>::kirchhoff_stress(m, f, &()))
-            }
-            Model::Plastic(p) => p.model().kirchhoff_stress(f, &state.plastic),
-        }
+        per_material!(self, kirchhoff_stress, f, state)
     }
 
     fn out_of_plane_stress(
@@ -172,12 +180,7 @@ impl<const D: usize, P: PlasticPart<D>> Constitutive<D> for MaterialTable<P> {
         f: &SMatrix<f64, D, D>,
         state: &Self::State,
     ) -> Result<f64, ConstitutiveError> {
-        match self.get(state.material)? {
-            Model::Elastic(m) => {
-                elastic_dispatch!(m, m => Constitutive::<D>::out_of_plane_stress(m, f, &()))
-            }
-            Model::Plastic(p) => p.model().out_of_plane_stress(f, &state.plastic),
-        }
+        per_material!(self, out_of_plane_stress, f, state)
     }
 
     fn energy_density(
@@ -185,12 +188,7 @@ impl<const D: usize, P: PlasticPart<D>> Constitutive<D> for MaterialTable<P> {
         f: &SMatrix<f64, D, D>,
         state: &Self::State,
     ) -> Result<f64, ConstitutiveError> {
-        match self.get(state.material)? {
-            Model::Elastic(m) => {
-                elastic_dispatch!(m, m => Constitutive::<D>::energy_density(m, f, &()))
-            }
-            Model::Plastic(p) => p.model().energy_density(f, &state.plastic),
-        }
+        per_material!(self, energy_density, f, state)
     }
 
     /// The stiffest material's modulus (the CFL bound must hold for all of them).

@@ -828,19 +828,98 @@ fn umls_within(args: &[&str], limit: std::time::Duration) -> Output {
 }
 
 /// Inputs that used to hang or name the wrong key: an infinite initial velocity, an
-/// absurd thread count, a Poisson ratio of 0.5, a friction angle in degrees.
+/// absurd thread count or end time, a Poisson ratio of 0.5, a friction angle in degrees,
+/// a jitter too large, a directory given as scene. Each fails within a minute and says
+/// what is wrong where.
 #[test]
 fn bad_values_fail_fast_and_name_their_key() {
     let dir = scratch("bad-values");
     std::fs::create_dir_all(&dir).unwrap();
     let disks = umls_cli::builtin::BUILTIN[0].toml;
-    let run = |name: &str, text: String, extra: &[&str]| {
-        let file = dir.join(format!("{name}.toml"));
-        std::fs::write(&file, text).unwrap();
+    let edit = |find: &str, replace: &str| Some(disks.replacen(find, replace, 1));
+    /// Case name, scene text (`None`: the directory itself), extra arguments, what the
+    /// message must say, what it must not say.
+    type Case<'a> = (
+        &'a str,
+        Option<String>,
+        &'a [&'a str],
+        &'a [&'a str],
+        &'a [&'a str],
+    );
+    let cases: [Case; 8] = [
+        (
+            "infinite-velocity",
+            edit("velocity = [0.1, 0.1]", "velocity = [\"1 / 0\", \"0\"]"),
+            &[],
+            &["bodies[0].velocity", "not finite"],
+            &[],
+        ),
+        (
+            "threads",
+            Some(disks.to_string()),
+            &["--threads", "100000"],
+            &["--threads", "100000"],
+            &[],
+        ),
+        (
+            "poisson",
+            edit("poisson = 0.3", "poisson = 0.5"),
+            &[],
+            &["materials[0].poisson", "0.5"],
+            &["materials[0].young"],
+        ),
+        (
+            "jitter",
+            edit("jitter = 0.2", "jitter = 0.5"),
+            &[],
+            &["jitter", "[0, 0.2]"],
+            &["MAX_JITTER"],
+        ),
+        ("directory", None, &[], &["is a directory"], &[]),
+        (
+            "end-time",
+            edit("end_time = 3.0", "end_time = 1e12"),
+            &[],
+            &["scene.end_time", "steps"],
+            &[],
+        ),
+        (
+            // The angle as given, in degrees, under its own key.
+            "friction",
+            edit(
+                "model = \"linear-elastic\"",
+                "model = \"drucker-prager\"\ncohesion = 10.0\nfriction_angle = 95.0",
+            ),
+            &[],
+            &["materials[0].friction_angle", "95", "90°"],
+            &["1.658"],
+        ),
+        (
+            // At a particle exactly on x = a the velocity is infinite; a rounding error
+            // away it is 10¹⁷ m/s, which the stable-step check stops at once.
+            "singular-velocity",
+            edit(
+                "velocity = [0.1, 0.1]",
+                "velocity = [\"1 / (x - 0.2125)\", \"0\"]",
+            ),
+            &[],
+            &[],
+            &[],
+        ),
+    ];
+    for (name, text, extra, says, never) in cases {
+        let scene = match text {
+            Some(text) => {
+                let file = dir.join(format!("{name}.toml"));
+                std::fs::write(&file, text).unwrap();
+                file
+            }
+            None => dir.clone(),
+        };
         let out_dir = dir.join(name);
         let mut args = vec![
             "run",
-            file.to_str().unwrap(),
+            scene.to_str().unwrap(),
             "--out",
             out_dir.to_str().unwrap(),
             "--quiet",
@@ -848,86 +927,20 @@ fn bad_values_fail_fast_and_name_their_key() {
         args.extend(extra);
         let out = umls_within(&args, std::time::Duration::from_secs(60));
         assert!(!out.status.success(), "{name} succeeded");
-        String::from_utf8_lossy(&out.stderr).into_owned()
-    };
-    let err = run(
-        "infinite-velocity",
-        disks.replacen("velocity = [0.1, 0.1]", "velocity = [\"1 / 0\", \"0\"]", 1),
-        &[],
-    );
-    assert!(
-        err.contains("bodies[0].velocity") && err.contains("not finite"),
-        "{err}"
-    );
-    let err = run(
-        "singular-velocity",
-        disks.replacen(
-            "velocity = [0.1, 0.1]",
-            "velocity = [\"1 / (x - 0.2125)\", \"0\"]",
-            1,
-        ),
-        &[],
-    );
-    // At a particle exactly on x = a it is infinite (the key's error); a particle a
-    // rounding error away gets 10¹⁷ m/s, which the stable-step check stops at once.
-    assert!(
-        err.contains("bodies[0].velocity") || err.contains("exceeds the stable step"),
-        "{err}"
-    );
-    let err = run("threads", disks.to_string(), &["--threads", "100000"]);
-    assert!(err.contains("--threads") && err.contains("100000"), "{err}");
-    let err = run(
-        "poisson",
-        disks.replacen("poisson = 0.3", "poisson = 0.5", 1),
-        &[],
-    );
-    assert!(
-        err.contains("materials[0].poisson") && err.contains("0.5"),
-        "{err}"
-    );
-    assert!(!err.contains("materials[0].young"), "{err}");
-    let err = run(
-        "jitter",
-        disks.replacen("jitter = 0.2", "jitter = 0.5", 1),
-        &[],
-    );
-    assert!(
-        err.contains("jitter") && err.contains("[0, 0.2]") && !err.contains("MAX_JITTER"),
-        "{err}"
-    );
-    let out = umls_within(
-        &["run", dir.to_str().unwrap()],
-        std::time::Duration::from_secs(60),
-    );
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        !out.status.success() && err.contains("is a directory"),
-        "{err}"
-    );
-    let err = run(
-        "end-time",
-        disks.replacen("end_time = 3.0", "end_time = 1e12", 1),
-        &[],
-    );
-    assert!(
-        err.contains("scene.end_time") && err.contains("steps"),
-        "{err}"
-    );
-    let err = run(
-        "friction",
-        disks.replacen(
-            "model = \"linear-elastic\"",
-            "model = \"drucker-prager\"\ncohesion = 10.0\nfriction_angle = 95.0",
-            1,
-        ),
-        &[],
-    );
-    // The angle as given, in degrees, under its own key.
-    assert!(
-        err.contains("materials[0].friction_angle") && err.contains("95"),
-        "{err}"
-    );
-    assert!(err.contains("90°") && !err.contains("1.658"), "{err}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        for s in says {
+            assert!(err.contains(s), "{name}: no `{s}` in {err}");
+        }
+        for s in never {
+            assert!(!err.contains(s), "{name}: `{s}` in {err}");
+        }
+        if name == "singular-velocity" {
+            assert!(
+                err.contains("bodies[0].velocity") || err.contains("exceeds the stable step"),
+                "{err}"
+            );
+        }
+    }
 }
 
 /// A body partly outside the mesh is clipped with a warning that says how much.
