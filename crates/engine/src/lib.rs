@@ -4,11 +4,14 @@
 //!
 //! One [`Simulation::step`]: evaluate every particle's stencil (in parallel, walking from
 //! its cached host), P2G of mass, momentum (with the affine term for affine schemes) and
-//! force (−Σ V⁰ τ ∇N + gravity), grid update with boundary conditions, G2P of velocity,
-//! affine matrix and position, then F ← (I + Δt∇v)F and the material's return map (USL,
-//! or MUSL with re-mapped momenta). Failures stop the run with a typed
-//! [`EngineError`] naming the step and particle or node: kernel errors, NaN, det F ≤ 0,
-//! energy blow-up.
+//! force (−Σ V⁰ τ ∇N + gravity and body forces), grid update (empty and mass-scaled nodes,
+//! damping, boundary conditions), G2P of velocity, affine matrix and position, walls that
+//! hold the particles, then F ← (I + Δt∇v)F and the material's return map (USL, or MUSL
+//! with re-mapped momenta). The time step is fixed or adaptive
+//! ([`Simulation::stable_time_step`]: one definition for every kernel). Failures stop the
+//! run with a typed [`EngineError`] naming the step and particle or node: kernel errors,
+//! NaN, det F ≤ 0, a Δt above the stable step, a particle moving more than a spacing per
+//! step, energy growing beyond what gravity and body forces put in.
 //!
 //! Parallel work is split into fixed chunks and every sum is taken in particle order, so
 //! results are bitwise identical for any number of threads.
