@@ -16,6 +16,14 @@ pub enum CliError {
         /// The reader's message.
         message: String,
     },
+    /// A mesh file could not be read; the reader's message names the line or byte.
+    #[error("{file}: {message}")]
+    MeshFile {
+        /// The mesh file.
+        file: String,
+        /// The reader's message.
+        message: String,
+    },
     /// A value in the scene is out of range or inconsistent.
     #[error("{file}: `{key}`: {reason}")]
     SceneValue {

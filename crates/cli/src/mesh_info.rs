@@ -5,7 +5,7 @@ use std::path::Path;
 
 use umls_io::gmsh::{AnyGmshMesh, GmshMesh, ReadOptions, read_msh_any};
 
-use crate::error::Result;
+use crate::error::{CliError, Result};
 
 fn report<const D: usize>(m: &GmshMesh<D>, path: &Path) -> String {
     let mut out = String::new();
@@ -59,7 +59,12 @@ fn report<const D: usize>(m: &GmshMesh<D>, path: &Path) -> String {
 
 /// The report for the mesh file at `path`.
 pub fn mesh_info(path: &Path) -> Result<String> {
-    Ok(match read_msh_any(path, ReadOptions::default())? {
+    // The reader's errors name the line or byte; the file is named here.
+    let mesh = read_msh_any(path, ReadOptions::default()).map_err(|e| CliError::MeshFile {
+        file: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    Ok(match mesh {
         AnyGmshMesh::Segments(m) => report(&m, path),
         AnyGmshMesh::Triangles(m) => report(&m, path),
         AnyGmshMesh::Tetrahedra(m) => report(&m, path),

@@ -83,7 +83,9 @@ impl Scene {
                 .ok_or_else(|| self.value_error("mesh.file", format!("no embedded mesh `{file}`"))),
             Some(dir) => {
                 let path = dir.join(file);
-                std::fs::read(&path).map_err(|source| CliError::File { path, source })
+                std::fs::read(&path).map_err(|source| {
+                    self.value_error("mesh.file", format!("{}: {source}", path.display()))
+                })
             }
         }
     }

@@ -415,6 +415,29 @@ fn mesh_info_reports_and_fails_clearly() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("line ") && err.contains("$EndNodes"), "{err}");
+    assert!(err.contains("bad.msh"), "the file is named: {err}");
+
+    // A scene whose mesh file is missing names the scene, the key and the path.
+    let scene = dir.join("scene.toml");
+    let text = umls_cli::builtin::BUILTIN[2].toml.replacen(
+        "file = \"meshes/cantilever.msh\"",
+        "file = \"meshes/missing.msh\"",
+        1,
+    );
+    assert!(text.contains("missing.msh"));
+    std::fs::write(&scene, text).unwrap();
+    let out = umls(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        dir.join("o").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("scene.toml") && err.contains("mesh.file") && err.contains("missing.msh"),
+        "{err}"
+    );
 }
 
 #[test]
