@@ -16,7 +16,7 @@ pub enum ConstitutiveError {
         reason: &'static str,
     },
     /// det F ≤ 0 (inverted or collapsed material) for a model defined only for det F > 0.
-    #[error("{model}: deformation gradient has det F = {det:e} ≤ 0")]
+    #[error("{model}: deformation gradient has det F = {det:.4e} ≤ 0")]
     NonPositiveJacobian {
         /// The model's name.
         model: &'static str,

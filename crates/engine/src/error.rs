@@ -42,7 +42,7 @@ pub enum EngineError {
         index: usize,
     },
     /// det F ≤ 0 after the deformation update.
-    #[error("step {step}, particle {particle}: det F = {det:e} ≤ 0 (material inverted)")]
+    #[error("step {step}, particle {particle}: det F = {det:.4e} ≤ 0 (material inverted)")]
     Inverted {
         /// Step number.
         step: usize,
@@ -54,7 +54,7 @@ pub enum EngineError {
     /// Kinetic plus elastic energy grew beyond the configured factor of the energy put
     /// into the body (initial energy plus the work of gravity and body forces).
     #[error(
-        "step {step}: kinetic + elastic energy {energy:e} exceeds {factor} × the {initial:e} put in (initial energy plus work of gravity and body forces): unstable"
+        "step {step}: kinetic + elastic energy {energy:.4e} exceeds {factor} × the {initial:.4e} put in (initial energy plus work of gravity and body forces): unstable"
     )]
     EnergyBlowUp {
         /// Step number.
@@ -83,7 +83,7 @@ pub enum EngineError {
     },
     /// The time step exceeds the explicit stability limit.
     #[error(
-        "step {step}: Δt = {dt:e} exceeds the stable step {stable:e} (wave Courant number {wave_courant:.3} > the limit): use a smaller dt or cfl, or an adaptive time step"
+        "step {step}: Δt = {dt:.4e} exceeds the stable step {stable:.4e} (wave Courant number {wave_courant:.3} > the limit): use a smaller dt or cfl, or an adaptive time step"
     )]
     TimeStepTooLarge {
         /// Step number.
