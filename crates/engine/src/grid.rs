@@ -107,6 +107,7 @@ impl<const D: usize> Grid<D> {
             redistributed_momentum: SVector::zeros(),
             scaled_nodes: 0,
         };
+        let mut active_mass = 0.0;
         for i in 0..self.mass.len() {
             let m = self.mass[i];
             if !self.is_active(i, cancellation_fraction) {
@@ -117,6 +118,7 @@ impl<const D: usize> Grid<D> {
                 self.new_velocity[i] = SVector::zeros();
                 continue;
             }
+            active_mass += m;
             let v = self.momentum[i] / m;
             let f = damped(self.force[i], v, m, damping);
             let scaled_mass = dt * dt * modulus * self.stiffness[i];
@@ -135,10 +137,6 @@ impl<const D: usize> Grid<D> {
         // vertex N = 0 but ∇N ≠ 0, so a force and no mass) and what mass-scaled nodes
         // did not absorb go to the active nodes in proportion to their mass: momentum
         // stays conserved to round-off, and the amount is reported.
-        let active_mass: f64 = (0..self.mass.len())
-            .filter(|&i| self.is_active(i, cancellation_fraction))
-            .map(|i| self.mass[i])
-            .sum();
         if active_mass > 0.0 && report.redistributed_momentum.norm_squared() > 0.0 {
             let shift = report.redistributed_momentum / active_mass;
             for i in 0..self.mass.len() {
