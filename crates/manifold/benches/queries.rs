@@ -1,8 +1,10 @@
 //! Queries per second for d = 1, 2 and n = 3, 100, 1000 at m = 1, 2: a helix (d = 1) and
-//! the sphere (d = 2), isometrically embedded in Rⁿ.
+//! the sphere (d = 2), isometrically embedded in Rⁿ. Then the neighbour index against a
+//! brute-force scan in R¹⁰⁰, on the embedded sphere (3 directions) and on a 2-torus spread
+//! over 16 directions, N = 16,000, 20 nearest.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use umls_manifold::{ManifoldMls, PointCloud, Settings};
+use umls_manifold::{ManifoldMls, NeighbourIndex, PointCloud, Settings};
 
 /// Orthonormal n×3 embedding columns from a deterministic generator.
 fn embedding(n: usize) -> Vec<Vec<f64>> {
@@ -91,5 +93,86 @@ fn queries(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, queries);
+/// A 2-torus in Rⁿ whose 16 Fourier features lie along random directions.
+fn spread_torus(n: usize, count: usize) -> Vec<f64> {
+    let mut state = 5u64;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let directions: Vec<Vec<f64>> = (0..16).map(|_| (0..n).map(|_| next()).collect()).collect();
+    let mut coords = Vec::with_capacity(n * count);
+    for _ in 0..count {
+        let (u, v) = (
+            std::f64::consts::TAU * next(),
+            std::f64::consts::TAU * next(),
+        );
+        let features: Vec<f64> = (0..16)
+            .map(|k| {
+                let f = (k / 4 + 1) as f64;
+                [(f * u).cos(), (f * u).sin(), (f * v).cos(), (f * v).sin()][k % 4]
+            })
+            .collect();
+        coords.extend((0..n).map(|j| (0..16).map(|k| directions[k][j] * features[k]).sum::<f64>()));
+    }
+    coords
+}
+
+/// The 20 nearest by computing every distance.
+fn brute_force(cloud: &PointCloud, query: &[f64], k: usize) -> usize {
+    let mut all: Vec<(f64, usize)> = (0..cloud.len())
+        .map(|i| {
+            let d: f64 = cloud
+                .point(i)
+                .iter()
+                .zip(query)
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum();
+            (d, i)
+        })
+        .collect();
+    all.select_nth_unstable_by(k, |a, b| a.0.total_cmp(&b.0));
+    all[..k].iter().map(|a| a.1).sum()
+}
+
+fn neighbours(c: &mut Criterion) {
+    let n = 100;
+    let count = 16_000;
+    let cols = embedding(n);
+    let sphere: Vec<f64> = samples(2, count)
+        .iter()
+        .flat_map(|p| embed(&cols, *p, n))
+        .collect();
+    let mut group = c.benchmark_group("neighbours_n100_N16k");
+    group.sample_size(10);
+    for (name, coords) in [("sphere", sphere), ("torus16", spread_torus(n, count))] {
+        let cloud = PointCloud::from_points(n, coords).expect("valid");
+        let index = NeighbourIndex::new(&cloud);
+        let queries: Vec<Vec<f64>> = (0..32)
+            .map(|q| cloud.point(q * 499).iter().map(|x| x + 1e-3).collect())
+            .collect();
+        group.throughput(Throughput::Elements(queries.len() as u64));
+        group.bench_function(BenchmarkId::new("index", name), |b| {
+            b.iter(|| {
+                queries
+                    .iter()
+                    .map(|q| index.nearest(&cloud, q, 20).expect("valid")[0].index)
+                    .sum::<usize>()
+            })
+        });
+        group.bench_function(BenchmarkId::new("brute_force", name), |b| {
+            b.iter(|| {
+                queries
+                    .iter()
+                    .map(|q| brute_force(&cloud, q, 20))
+                    .sum::<usize>()
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, queries, neighbours);
 criterion_main!(benches);

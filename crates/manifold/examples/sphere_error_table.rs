@@ -50,9 +50,8 @@ fn main() -> Result<(), ManifoldError> {
                 PointCloud::new(3, coords.clone(), 1, values.clone())?,
                 Settings::new(2, m),
             )?;
-            let flat: Vec<f64> = queries.iter().flatten().copied().collect();
             let mut error: f64 = 0.0;
-            for (estimate, q) in mls.evaluate_batch(&flat)?.into_iter().zip(&queries) {
+            for (estimate, q) in mls.evaluate_batch(&queries).into_iter().zip(&queries) {
                 error = error.max((estimate?.value[0] - f(q)).abs());
             }
             // h ∝ N^(−1/2) and N grows 4× per level: order = log₂(e_prev / e).

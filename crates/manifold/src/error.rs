@@ -41,7 +41,7 @@ pub enum ManifoldError {
     },
     /// Fewer samples with positive weight than the polynomial needs.
     #[error(
-        "{found} neighbours with positive weight, but a degree-{degree} polynomial in {intrinsic} variables needs at least {needed}"
+        "only {found} samples have positive weight within the bandwidth, but a degree-{degree} polynomial in {intrinsic} variables has {needed} coefficients"
     )]
     TooFewNeighbours {
         /// Neighbours with positive weight.
@@ -53,16 +53,65 @@ pub enum ManifoldError {
         /// Intrinsic dimension d.
         intrinsic: usize,
     },
-    /// The weighted design matrix is numerically rank deficient.
+    /// The bandwidth rule gave no usable σ (zero, or not finite: samples at one
+    /// position, or coordinates so large that distances overflow).
     #[error(
-        "weighted least-squares fit is rank deficient: |R| diagonal ratio {ratio:e} (neighbours nearly on a lower-dimensional set)"
+        "bandwidth σ = {sigma:.4e} from the distance to the {neighbours}-th nearest distinct sample is not a positive finite number"
+    )]
+    BandwidthUndefined {
+        /// The σ found.
+        sigma: f64,
+        /// K* of the rule.
+        neighbours: usize,
+    },
+    /// The neighbours are nearly on a lower-dimensional set: the local plane is undefined.
+    #[error(
+        "the neighbours span fewer than d directions (relative spread of the d-th direction {ratio:.4e})"
     )]
     RankDeficient {
-        /// Smallest over largest |R_ii| of the QR factor.
+        /// Relative spread of the weakest tangent direction (0 when undefined).
         ratio: f64,
     },
+    /// The weighted fit does not pin down its coefficients: the samples are too uneven
+    /// (for instance all on a line of a surface) even after widening the bandwidth.
+    #[error(
+        "fit is ill-conditioned: condition number {condition:.4e} exceeds {limit:.4e} at bandwidth σ = {sigma:.4e} (samples too uneven around the query)"
+    )]
+    IllConditioned {
+        /// Condition number of the column-equilibrated weighted design.
+        condition: f64,
+        /// The limit of the settings.
+        limit: f64,
+        /// Widest bandwidth tried.
+        sigma: f64,
+    },
+    /// The query is too far from every sample: the data do not determine its chart.
+    #[error(
+        "query is {distance:.4e} from the nearest sample, beyond the limit {limit:.4e} (max_offset × σ): the data do not determine its chart"
+    )]
+    QueryTooFar {
+        /// Distance to the nearest sample.
+        distance: f64,
+        /// `max_offset` × σ there.
+        limit: f64,
+    },
+    /// The query sits near a centre of curvature of the reconstructed manifold (the
+    /// centre of a sampled sphere): many points are about equally close, so its
+    /// projection and value are not unique.
+    #[error(
+        "query is {distance:.4e} from the reconstructed manifold, near its centre of curvature (radius {radius:.4e}): the projection is not unique"
+    )]
+    FocalQuery {
+        /// Distance from the query to its projection.
+        distance: f64,
+        /// Smallest radius of curvature towards the query.
+        radius: f64,
+    },
+    /// A neighbour index asked about a cloud it was not built from.
+    #[error("the neighbour index was built from a different point cloud")]
+    ForeignCloud,
     /// The chart iteration did not settle.
-    #[error("local chart did not converge in {iterations} iterations (last step {step:e} × σ)")]
+    #[error("local chart did not converge in {iterations} iterations (last step {step:.4e} × σ)")]
     NotConverged {
         /// Iterations performed.
         iterations: usize,

@@ -1,32 +1,53 @@
-//! Monomials of total degree ≤ m in d variables, and weighted least-squares fits by QR.
+//! Monomials of total degree ≤ m in d variables, and the weighted least-squares fit of
+//! values and offsets in a chart.
 
-use nalgebra::DMatrix;
-
+use crate::chart::{FrameChart, theta};
+use crate::dense::{dot, least_squares};
 use crate::error::ManifoldError;
+use crate::frame::Frame;
 
 /// The monomial basis x^α, |α| ≤ m, ordered by total degree: 1, then x₁ … x_d, then the
 /// higher degrees. So coefficient 0 is the value at 0 and coefficients 1..=d the gradient.
+/// With d = 0 the basis is the constant alone.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Monomials {
     intrinsic: usize,
     degree: usize,
-    exponents: Vec<Vec<u8>>,
+    exponents: Vec<Vec<u32>>,
 }
 
 impl Monomials {
     /// All monomials of total degree ≤ `degree` in `intrinsic` variables.
-    pub fn new(intrinsic: usize, degree: usize) -> Self {
-        let mut exponents = Vec::new();
-        for total in 0..=degree {
-            let mut current = vec![0u8; intrinsic];
-            push_with_total(&mut exponents, &mut current, 0, total);
+    ///
+    /// Fails with [`ManifoldError::InvalidParameter`] when the basis would have more than
+    /// [`Monomials::MAX_LEN`] members (C(d + m, d) grows fast: no least-squares fit of that
+    /// size is meant).
+    pub fn new(intrinsic: usize, degree: usize) -> Result<Self, ManifoldError> {
+        if basis_size(intrinsic, degree).is_none_or(|len| len > Self::MAX_LEN) {
+            return Err(ManifoldError::InvalidParameter {
+                parameter: "degree",
+                value: degree as f64,
+                reason: "C(d + m, d) monomials exceed 10⁵",
+            });
         }
-        Self {
+        let mut exponents = Vec::new();
+        if intrinsic == 0 {
+            exponents.push(Vec::new());
+        } else {
+            for total in 0..=degree as u32 {
+                let mut current = vec![0u32; intrinsic];
+                push_with_total(&mut exponents, &mut current, 0, total);
+            }
+        }
+        Ok(Self {
             intrinsic,
             degree,
             exponents,
-        }
+        })
     }
+
+    /// Largest basis [`Monomials::new`] builds.
+    pub const MAX_LEN: usize = 100_000;
 
     /// Number of monomials, C(d + m, d).
     pub fn len(&self) -> usize {
@@ -43,82 +64,160 @@ impl Monomials {
         self.degree
     }
 
-    /// Writes the monomials at `x` into `out`.
+    /// Number of variables d.
+    pub fn intrinsic_dim(&self) -> usize {
+        self.intrinsic
+    }
+
+    /// Exponent vectors α, one per monomial, in basis order.
+    pub fn exponents(&self) -> &[Vec<u32>] {
+        &self.exponents
+    }
+
+    /// Writes the monomials at `x` (d values) into `out` (len values).
     pub fn evaluate(&self, x: &[f64], out: &mut [f64]) {
         for (o, alpha) in out.iter_mut().zip(&self.exponents) {
             *o = alpha
                 .iter()
                 .zip(x)
-                .map(|(&a, &xi)| xi.powi(i32::from(a)))
+                .map(|(&a, &xi)| xi.powi(a as i32))
                 .product();
         }
     }
 }
 
+/// C(d + m, d), `None` on overflow.
+fn basis_size(d: usize, m: usize) -> Option<usize> {
+    let mut size: usize = 1;
+    for i in 1..=d.min(m) {
+        size = size.checked_mul(d.max(m).checked_add(i)?)? / i;
+        // Already too large to build: stop before counting to the end.
+        if size > Monomials::MAX_LEN {
+            return None;
+        }
+    }
+    Some(size)
+}
+
 /// Exponent vectors with the given total, in lexicographic order from the first variable.
-fn push_with_total(out: &mut Vec<Vec<u8>>, current: &mut Vec<u8>, var: usize, remaining: usize) {
+fn push_with_total(out: &mut Vec<Vec<u32>>, current: &mut Vec<u32>, var: usize, remaining: u32) {
     if var + 1 == current.len() {
-        current[var] = remaining as u8;
+        current[var] = remaining;
         out.push(current.clone());
         return;
     }
     for k in (0..=remaining).rev() {
-        current[var] = k as u8;
+        current[var] = k;
         push_with_total(out, current, var + 1, remaining - k);
     }
     current[var] = 0;
 }
 
-/// Minimises Σ_i w_i ‖P(x_i) c − b_i‖² by QR of √W P (never the normal equations).
-///
-/// `coords` is K×d (scaled chart coordinates), `rhs` K×k; returns the M×k coefficients.
-/// Rows with zero weight are dropped first.
-pub fn weighted_fit(
+/// Scratch buffers of [`fit_values_and_offsets`].
+#[derive(Debug, Default)]
+pub(crate) struct FitScratch {
+    design: Vec<f64>,
+    pub(crate) solution: Vec<f64>,
+    row: Vec<f64>,
+    x: Vec<f64>,
+    lsq: Vec<f64>,
+    used: Vec<(usize, f64)>,
+}
+
+/// What a fit in the chart produced.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FitSummary {
+    /// Rows of the solution (leading dimension of `FitScratch::solution`).
+    pub rows: usize,
+    /// Condition number of the column-equilibrated weighted design.
+    pub condition: f64,
+    /// Neighbours with positive weight.
+    pub neighbours: usize,
+    /// Kish's effective sample size (Σw)² / Σw².
+    pub effective: f64,
+}
+
+/// Weighted degree-m fit in the chart of the `k` values of every neighbour (from
+/// `value_of`) and of its offset y_i − q (frame dimension columns): minimises
+/// Σ_i w_i ‖P(x_i) c − b_i‖² by Householder QR of √W P. Coefficients are in
+/// `scratch.solution`, column j at `j·rows`, coefficient order as in [`Monomials`].
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn fit_values_and_offsets<'v>(
+    frame: &Frame,
+    chart: &FrameChart,
+    mass: &[f64],
     monomials: &Monomials,
-    coords: &DMatrix<f64>,
-    weights: &[f64],
-    rhs: &DMatrix<f64>,
-) -> Result<DMatrix<f64>, ManifoldError> {
-    let used: Vec<usize> = (0..weights.len()).filter(|&i| weights[i] > 0.0).collect();
-    let m = monomials.len();
-    if used.len() < m {
+    sigma: f64,
+    k: usize,
+    value_of: impl Fn(usize) -> &'v [f64],
+    scratch: &mut FitScratch,
+) -> Result<FitSummary, ManifoldError> {
+    let (dim, d, m) = (frame.dim, monomials.intrinsic, monomials.len());
+    scratch.used.clear();
+    for (i, (y, mass)) in frame.coords.chunks_exact(dim).zip(mass).enumerate() {
+        let t = y
+            .iter()
+            .zip(&chart.q)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+            .sqrt();
+        let w = mass * theta(t, sigma);
+        if w > 0.0 {
+            scratch.used.push((i, w));
+        }
+    }
+    let rows = scratch.used.len();
+    let (sum, sum2) = scratch
+        .used
+        .iter()
+        .fold((0.0, 0.0), |(s, s2), (_, w)| (s + w, s2 + w * w));
+    if rows < m {
         return Err(ManifoldError::TooFewNeighbours {
-            found: used.len(),
+            found: rows,
             needed: m,
             degree: monomials.degree,
-            intrinsic: monomials.intrinsic,
+            intrinsic: d,
         });
     }
-    let mut design = DMatrix::<f64>::zeros(used.len(), m);
-    let mut target = DMatrix::<f64>::zeros(used.len(), rhs.ncols());
-    let mut row = vec![0.0; m];
-    let mut x = vec![0.0; coords.ncols()];
-    for (r, &i) in used.iter().enumerate() {
-        let sw = weights[i].sqrt();
-        for (k, xk) in x.iter_mut().enumerate() {
-            *xk = coords[(i, k)];
+    let columns = k + dim;
+    scratch.design.clear();
+    scratch.design.resize(rows * m, 0.0);
+    scratch.solution.clear();
+    scratch.solution.resize(rows * columns, 0.0);
+    scratch.row.resize(m, 0.0);
+    scratch.x.resize(d, 0.0);
+    for (r, &(i, w)) in scratch.used.iter().enumerate() {
+        let sw = w.sqrt();
+        let y = &frame.coords[i * dim..(i + 1) * dim];
+        for (a, x) in scratch.x.iter_mut().enumerate() {
+            let u = &chart.u[a * dim..(a + 1) * dim];
+            *x = (dot(u, y) - dot(u, &chart.q)) / sigma;
         }
-        monomials.evaluate(&x, &mut row);
-        for (c, v) in row.iter().enumerate() {
-            design[(r, c)] = sw * v;
+        monomials.evaluate(&scratch.x, &mut scratch.row);
+        for (c, v) in scratch.row.iter().enumerate() {
+            scratch.design[r + c * rows] = sw * v;
         }
-        for c in 0..rhs.ncols() {
-            target[(r, c)] = sw * rhs[(i, c)];
+        for (c, v) in value_of(i).iter().enumerate() {
+            scratch.solution[r + c * rows] = sw * v;
+        }
+        for (c, (y, q)) in y.iter().zip(&chart.q).enumerate() {
+            scratch.solution[r + (k + c) * rows] = sw * (y - q);
         }
     }
-    let qr = design.qr();
-    let r = qr.r();
-    let diag: Vec<f64> = (0..m).map(|i| r[(i, i)].abs()).collect();
-    let (lo, hi) = diag.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &d| {
-        (lo.min(d), hi.max(d))
-    });
-    let ratio = lo / hi;
-    if ratio.is_nan() || ratio <= 1e-12 {
-        return Err(ManifoldError::RankDeficient { ratio });
-    }
-    let qt_b = qr.q().transpose() * target;
-    r.solve_upper_triangular(&qt_b)
-        .ok_or(ManifoldError::RankDeficient { ratio })
+    let conditioning = least_squares(
+        &mut scratch.design,
+        rows,
+        m,
+        &mut scratch.solution,
+        columns,
+        &mut scratch.lsq,
+    );
+    Ok(FitSummary {
+        rows,
+        condition: conditioning.condition,
+        neighbours: rows,
+        effective: sum * sum / sum2,
+    })
 }
 
 #[cfg(test)]
@@ -127,12 +226,37 @@ mod tests {
 
     #[test]
     fn counts_and_order() {
-        assert_eq!(Monomials::new(2, 3).len(), 10);
-        assert_eq!(Monomials::new(3, 2).len(), 10);
-        assert_eq!(Monomials::new(1, 0).len(), 1);
-        let m = Monomials::new(2, 2);
+        assert_eq!(Monomials::new(2, 3).unwrap().len(), 10);
+        assert_eq!(Monomials::new(3, 2).unwrap().len(), 10);
+        assert_eq!(Monomials::new(1, 0).unwrap().len(), 1);
+        let m = Monomials::new(2, 2).unwrap();
         let mut out = vec![0.0; 6];
         m.evaluate(&[2.0, 3.0], &mut out);
         assert_eq!(out, vec![1.0, 2.0, 3.0, 4.0, 6.0, 9.0]);
+    }
+
+    #[test]
+    fn edges_of_the_basis() {
+        // d = 0: the constant alone, whatever the degree.
+        let constant = Monomials::new(0, 3).unwrap();
+        assert_eq!(constant.len(), 1);
+        let mut out = [0.0];
+        constant.evaluate(&[], &mut out);
+        assert_eq!(out, [1.0]);
+        // Degrees past 255 no longer wrap: x^300 is x^300.
+        let high = Monomials::new(1, 300).unwrap();
+        assert_eq!(high.len(), 301);
+        let mut out = vec![0.0; 301];
+        high.evaluate(&[1.001], &mut out);
+        assert!((out[300] - 1.001f64.powi(300)).abs() < 1e-12 * out[300]);
+        // A basis too large to fit is refused, not allocated.
+        assert!(matches!(
+            Monomials::new(10, 50),
+            Err(ManifoldError::InvalidParameter {
+                parameter: "degree",
+                ..
+            })
+        ));
+        assert!(Monomials::new(usize::MAX, usize::MAX).is_err());
     }
 }

@@ -193,6 +193,7 @@ fn typed_errors() {
             index: 0
         })
     ));
+    // σ fixed so small that the query has no chart, then just too small for 6 samples.
     let tiny = Settings {
         bandwidth: Bandwidth::Fixed(1e-3),
         ..Settings::new(2, 2)
@@ -201,16 +202,27 @@ fn typed_errors() {
     let err = mls
         .evaluate(&[0.3, 0.4, (1.0f64 - 0.25).sqrt()])
         .unwrap_err();
-    assert!(
-        matches!(
-            err,
-            ManifoldError::TooFewNeighbours {
-                needed: 6,
-                degree: 2,
-                ..
-            }
-        ),
-        "{err}"
+    assert!(matches!(err, ManifoldError::QueryTooFar { .. }), "{err}");
+    let narrow = Settings {
+        bandwidth: Bandwidth::Fixed(0.3),
+        ..Settings::new(2, 2)
+    };
+    let err = ManifoldMls::new(cloud.clone(), narrow)
+        .unwrap()
+        .evaluate(&pts[7])
+        .unwrap_err();
+    assert_eq!(
+        err,
+        ManifoldError::TooFewNeighbours {
+            found: 5,
+            needed: 6,
+            degree: 2,
+            intrinsic: 2
+        }
+    );
+    assert_eq!(
+        err.to_string(),
+        "only 5 samples have positive weight within the bandwidth, but a degree-2 polynomial in 2 variables has 6 coefficients"
     );
     let capped = Settings {
         max_iterations: 1,
@@ -242,22 +254,26 @@ fn batch_is_deterministic_and_order_independent() {
         Settings::new(2, 2),
     )
     .unwrap();
-    let queries: Vec<f64> = common::fibonacci_sphere(64)
-        .iter()
-        .flatten()
-        .copied()
-        .collect();
-    let batch = mls.evaluate_batch(&queries).unwrap();
-    let reversed: Vec<f64> = queries.chunks_exact(3).rev().flatten().copied().collect();
-    let batch_reversed = mls.evaluate_batch(&reversed).unwrap();
-    for (i, r) in queries.chunks_exact(3).enumerate() {
+    let queries = common::fibonacci_sphere(64);
+    let batch = mls.evaluate_batch(&queries);
+    let reversed: Vec<[f64; 3]> = queries.iter().rev().copied().collect();
+    let batch_reversed = mls.evaluate_batch(&reversed);
+    for (i, r) in queries.iter().enumerate() {
         let single = mls.evaluate(r).unwrap();
         assert_eq!(batch[i].as_ref().unwrap(), &single);
         assert_eq!(batch_reversed[63 - i].as_ref().unwrap(), &single);
     }
-    let projections = mls.project_batch(&queries).unwrap();
+    // Slices of a flat buffer work as queries too, and a bad one fails alone.
+    let flat: Vec<f64> = queries.iter().flatten().copied().collect();
+    let mut rows: Vec<&[f64]> = flat.chunks_exact(3).collect();
+    rows.push(&flat[..2]);
+    let projections = mls.project_batch(&rows);
     assert_eq!(
         projections[5].as_ref().unwrap(),
-        &mls.project(&queries[15..18]).unwrap()
+        &mls.evaluate(&queries[5]).unwrap().projection
     );
+    assert!(matches!(
+        projections[64],
+        Err(ManifoldError::LengthMismatch { what: "query", .. })
+    ));
 }

@@ -29,7 +29,7 @@ fn check(ambient: usize, coords: Vec<f64>, queries: &[f64], k: usize) -> Result<
     let index = NeighbourIndex::new(&cloud);
     for q in queries.chunks_exact(ambient) {
         let expected = brute(&cloud, q);
-        let found = index.nearest(&cloud, q, k);
+        let found = index.nearest(&cloud, q, k).unwrap();
         prop_assert_eq!(found.len(), k.min(cloud.len()));
         for (f, e) in found.iter().zip(&expected) {
             // Ties may order differently; distances must match exactly.
@@ -41,7 +41,7 @@ fn check(ambient: usize, coords: Vec<f64>, queries: &[f64], k: usize) -> Result<
             );
         }
         let radius = expected[(k / 2).min(expected.len() - 1)].1;
-        let within = index.within(&cloud, q, radius);
+        let within = index.within(&cloud, q, radius).unwrap();
         let count = expected.iter().filter(|e| e.1 <= radius).count();
         prop_assert_eq!(within.len(), count, "radius query");
     }
