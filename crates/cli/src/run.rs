@@ -26,7 +26,7 @@ use crate::output::OutputDir;
 use crate::plot::EnergyRecord;
 use crate::progress::Progress;
 use crate::scene::Scene;
-use crate::schema::{BoundaryKind, KernelKind, TransferKind};
+use crate::schema::{BoundaryKind, EncodingSpec, KernelKind, TransferKind};
 use crate::setup::{self, BoundaryTarget, Setup, Split};
 
 /// Command-line overrides and output settings of a run.
@@ -164,15 +164,9 @@ fn run_dim<const D: usize, X: Dimension<D>>(
     options: &RunOptions,
 ) -> Result<RunReport> {
     let setup = setup::build::<D>(scene, X::SPLIT)?;
-    let encoding = match scene.spec.output.encoding.as_deref().unwrap_or("binary") {
-        "binary" => Encoding::Binary,
-        "ascii" => Encoding::Ascii,
-        other => {
-            return Err(scene.value_error(
-                "output.encoding",
-                format!("`{other}`: expected binary or ascii"),
-            ));
-        }
+    let encoding = match scene.spec.output.encoding {
+        EncodingSpec::Binary => Encoding::Binary,
+        EncodingSpec::Ascii => Encoding::Ascii,
     };
     let ctx = Context {
         scene,
@@ -598,7 +592,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         "dimension": D,
         "kernel": ctx.kernel.name(),
         "transfer": transfer_name(&spec.transfer),
-        "stress_update": spec.time.stress_update.as_deref().unwrap_or("usl"),
+        "stress_update": spec.time.stress_update.name(),
         "materials": setup.material_names,
         "particles": sim.particles.len(),
         "nodes": sim.kernel.node_count(),

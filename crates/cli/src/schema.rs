@@ -103,8 +103,8 @@ pub struct LatticeSpec {
     /// Seed of the jitter.
     #[serde(default)]
     pub seed: u64,
-    /// Triangle diagonals (2D): "right", "left", "alternating", "crossed".
-    pub diagonal: Option<String>,
+    /// Triangle diagonals (2D only).
+    pub diagonal: Option<DiagonalSpec>,
 }
 
 /// Kernel names.
@@ -194,8 +194,9 @@ pub struct TimeSpec {
     pub dt: Option<f64>,
     /// Time step as a fraction of the CFL limit h / c.
     pub cfl: Option<f64>,
-    /// "usl" (default) or "musl".
-    pub stress_update: Option<String>,
+    /// Stress update scheme (default USL).
+    #[serde(default)]
+    pub stress_update: StressUpdateSpec,
     /// Recompute Δt = cfl · h / (c + |v|_max) before every step (needs `cfl`; `dt`, if
     /// also given, is the largest step).
     #[serde(default)]
@@ -213,8 +214,9 @@ pub struct OutputSpec {
     /// Write diagnostics to `history.csv` every this many steps (default 1).
     #[serde(default = "default_history_every")]
     pub history_every: usize,
-    /// "binary" (default) or "ascii" VTK data arrays.
-    pub encoding: Option<String>,
+    /// VTK data arrays (default binary).
+    #[serde(default)]
+    pub encoding: EncodingSpec,
 }
 
 fn default_history_every() -> usize {
@@ -227,40 +229,182 @@ impl Default for OutputSpec {
             frames: None,
             interval: None,
             history_every: default_history_every(),
-            encoding: None,
+            encoding: EncodingSpec::default(),
         }
     }
 }
 
-/// `[[materials]]`.
+/// `[[materials]]`: `model` selects the variant, and each variant accepts only its own
+/// keys, so `yield_stress` on a linear-elastic material is an error that names the key
+/// instead of a silently ignored setting.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(tag = "model", rename_all = "kebab-case")]
+pub enum MaterialSpec {
+    /// Small-strain linear elasticity.
+    LinearElastic(SolidSpec),
+    /// Compressible neo-Hookean.
+    NeoHookean(SolidSpec),
+    /// St. Venant–Kirchhoff.
+    StVenantKirchhoff(SolidSpec),
+    /// Fixed corotated.
+    FixedCorotated(SolidSpec),
+    /// Weakly compressible (Tait) fluid.
+    Fluid(FluidSpec),
+    /// Drucker–Prager elastoplasticity (cone fitted to Mohr–Coulomb in plane strain).
+    DruckerPrager(DruckerPragerSpec),
+    /// von Mises (J2) elastoplasticity with linear hardening.
+    VonMises(VonMisesSpec),
+}
+
+impl MaterialSpec {
+    /// The name bodies refer to.
+    pub fn name(&self) -> &str {
+        match self {
+            Self::LinearElastic(m)
+            | Self::NeoHookean(m)
+            | Self::StVenantKirchhoff(m)
+            | Self::FixedCorotated(m) => &m.name,
+            Self::Fluid(m) => &m.name,
+            Self::DruckerPrager(m) => &m.name,
+            Self::VonMises(m) => &m.name,
+        }
+    }
+
+    /// Mass density.
+    pub fn density(&self) -> f64 {
+        match self {
+            Self::LinearElastic(m)
+            | Self::NeoHookean(m)
+            | Self::StVenantKirchhoff(m)
+            | Self::FixedCorotated(m) => m.density,
+            Self::Fluid(m) => m.density,
+            Self::DruckerPrager(m) => m.density,
+            Self::VonMises(m) => m.density,
+        }
+    }
+}
+
+/// Keys of the elastic solid models.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct MaterialSpec {
+pub struct SolidSpec {
     /// Name bodies refer to.
     pub name: String,
-    /// "linear-elastic", "neo-hookean", "st-venant-kirchhoff", "fixed-corotated",
-    /// "fluid", "drucker-prager", "von-mises".
-    pub model: String,
-    /// Density.
+    /// Mass density.
     pub density: f64,
-    /// Young's modulus (solids).
-    pub young: Option<f64>,
-    /// Poisson's ratio (solids).
-    pub poisson: Option<f64>,
-    /// Bulk modulus (fluid).
-    pub bulk: Option<f64>,
-    /// Pressure exponent γ (fluid, default 7).
+    /// Young's modulus.
+    pub young: f64,
+    /// Poisson's ratio.
+    pub poisson: f64,
+}
+
+/// Keys of `model = "fluid"`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FluidSpec {
+    /// Name bodies refer to.
+    pub name: String,
+    /// Mass density.
+    pub density: f64,
+    /// Bulk modulus.
+    pub bulk: f64,
+    /// Pressure exponent γ (default 7).
     pub gamma: Option<f64>,
-    /// Cohesion (Drucker–Prager).
-    pub cohesion: Option<f64>,
-    /// Friction angle in degrees (Drucker–Prager).
-    pub friction_angle: Option<f64>,
-    /// Dilatancy angle in degrees (Drucker–Prager, default 0).
+}
+
+/// Keys of `model = "drucker-prager"`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DruckerPragerSpec {
+    /// Name bodies refer to.
+    pub name: String,
+    /// Mass density.
+    pub density: f64,
+    /// Young's modulus.
+    pub young: f64,
+    /// Poisson's ratio.
+    pub poisson: f64,
+    /// Cohesion.
+    pub cohesion: f64,
+    /// Friction angle in degrees.
+    pub friction_angle: f64,
+    /// Dilatancy angle in degrees (default 0).
     pub dilatancy_angle: Option<f64>,
-    /// Uniaxial yield stress (von Mises).
-    pub yield_stress: Option<f64>,
-    /// Linear hardening modulus (von Mises, default 0).
+}
+
+/// Keys of `model = "von-mises"`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VonMisesSpec {
+    /// Name bodies refer to.
+    pub name: String,
+    /// Mass density.
+    pub density: f64,
+    /// Young's modulus.
+    pub young: f64,
+    /// Poisson's ratio.
+    pub poisson: f64,
+    /// Uniaxial yield stress.
+    pub yield_stress: f64,
+    /// Linear hardening modulus (default 0).
     pub hardening: Option<f64>,
+}
+
+/// `time.stress_update`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StressUpdateSpec {
+    /// Update stress last.
+    #[default]
+    Usl,
+    /// Modified update stress last (velocities re-mapped before the stress update).
+    Musl,
+}
+
+impl StressUpdateSpec {
+    /// The name in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Usl => "usl",
+            Self::Musl => "musl",
+        }
+    }
+}
+
+/// `output.encoding`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EncodingSpec {
+    /// Base64 binary data arrays.
+    #[default]
+    Binary,
+    /// ASCII data arrays.
+    Ascii,
+}
+
+/// `mesh.lattice.diagonal` (2D).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DiagonalSpec {
+    /// Every square split along its rising diagonal.
+    Right,
+    /// Every square split along its falling diagonal.
+    Left,
+    /// Diagonals alternating in a chequerboard.
+    #[default]
+    Alternating,
+    /// Four triangles per square around its centre.
+    Crossed,
+}
+
+/// `seeding.mesh`: where in each cell particles go.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum QuadratureSpec {
+    /// One particle at the centroid.
+    Centroid,
+    /// The degree-2 Gauss points.
+    Gauss2,
 }
 
 /// A velocity component: a number or an expression in x, y, z (and t for references).
@@ -310,8 +454,8 @@ pub enum RegionSpec {
 pub enum SeedingSpec {
     /// A regular lattice of this spacing over the mesh's bounding box.
     Lattice(f64),
-    /// Quadrature points of the mesh cells: "centroid" or "gauss2".
-    Mesh(String),
+    /// Quadrature points of the mesh cells.
+    Mesh(QuadratureSpec),
 }
 
 /// `[[bodies]]`.

@@ -17,7 +17,10 @@ use crate::error::{CliError, Result};
 use crate::expression::VectorField;
 use crate::material::{ElasticModel, Model, PlasticModel};
 use crate::scene::Scene;
-use crate::schema::{BoundaryKind, RegionSpec, SeedingSpec};
+use crate::schema::{
+    BoundaryKind, DiagonalSpec, MaterialSpec, QuadratureSpec, RegionSpec, SeedingSpec, SolidSpec,
+    StressUpdateSpec,
+};
 
 /// Most lattice points a seeding may generate before filtering by region, and most cells
 /// of a generated lattice mesh: a typo in a spacing or count should be an error, not an
@@ -175,21 +178,16 @@ fn mesh<const D: usize>(
                 .map(|k| (upper[k] - lower[k]) / cells[k].max(1) as f64)
                 .fold(f64::INFINITY, f64::min);
             let lattice = Lattice::new(lower.into(), upper.into(), cells).jitter(l.jitter, l.seed);
-            let diagonal = match l.diagonal.as_deref() {
-                None | Some("alternating") => Diagonal::Alternating,
-                Some(_) if D != 2 => {
-                    return Err(scene
-                        .value_error("mesh.lattice.diagonal", "only 2D lattices have diagonals"));
-                }
-                Some("right") => Diagonal::Right,
-                Some("left") => Diagonal::Left,
-                Some("crossed") => Diagonal::Crossed,
-                Some(other) => {
-                    return Err(scene.value_error(
-                        "mesh.lattice.diagonal",
-                        format!("`{other}`: expected right, left, alternating or crossed"),
-                    ));
-                }
+            if l.diagonal.is_some() && D != 2 {
+                return Err(
+                    scene.value_error("mesh.lattice.diagonal", "only 2D lattices have diagonals")
+                );
+            }
+            let diagonal = match l.diagonal.unwrap_or_default() {
+                DiagonalSpec::Alternating => Diagonal::Alternating,
+                DiagonalSpec::Right => Diagonal::Right,
+                DiagonalSpec::Left => Diagonal::Left,
+                DiagonalSpec::Crossed => Diagonal::Crossed,
             };
             let mesh = split(&lattice, diagonal)
                 .map_err(|e| scene.value_error("mesh.lattice", e.to_string()))?;
@@ -200,16 +198,11 @@ fn mesh<const D: usize>(
 }
 
 fn material(scene: &Scene, index: usize) -> Result<Model<PlasticModel>> {
-    let m = &scene.spec.materials[index];
+    let spec = &scene.spec.materials[index];
     let key = |field: &str| format!("materials[{index}].{field}");
-    let need = |value: Option<f64>, field: &str| {
-        value.ok_or_else(|| {
-            scene.value_error(key(field), format!("required by model `{}`", m.model))
-        })
-    };
-    // The key of the parameter the model rejected (not the first key of the model), with
-    // angles shown in the degrees the file gives them in.
-    let bad = |field: &str, e: umls_constitutive::ConstitutiveError| match e {
+    // The key of the parameter the model rejected, with angles shown in the degrees the
+    // file gives them in.
+    let bad = |e: umls_constitutive::ConstitutiveError| match e {
         umls_constitutive::ConstitutiveError::InvalidParameter {
             parameter,
             value,
@@ -225,73 +218,63 @@ fn material(scene: &Scene, index: usize) -> Result<Model<PlasticModel>> {
                 "hardening modulus" => ("hardening", value),
                 "K (bulk modulus)" => ("bulk", value),
                 "γ (exponent)" => ("gamma", value),
-                _ => (field, value),
+                other => (other, value),
             };
             let reason = reason
                 .replace("[0, π/2)", "[0°, 90°)")
                 .replace("[0, friction angle]", "[0°, friction_angle]");
             scene.value_error(key(field), format!("{value}: {reason}"))
         }
-        other => scene.value_error(key(field), other.to_string()),
+        other => scene.value_error(key("model"), other.to_string()),
     };
-    if !(m.density.is_finite() && m.density > 0.0) {
+    let density = spec.density();
+    if !(density.is_finite() && density > 0.0) {
         return Err(scene.value_error(key("density"), "must be finite and positive"));
     }
-    let elastic = || {
-        ElasticParameters::from_young_poisson(need(m.young, "young")?, need(m.poisson, "poisson")?)
-            .map_err(|e| bad("young", e))
+    let elastic = |young: f64, poisson: f64| {
+        ElasticParameters::from_young_poisson(young, poisson).map_err(bad)
     };
-    let degrees = |v: f64| v.to_radians();
-    Ok(match m.model.as_str() {
-        "linear-elastic" => Model::Elastic(ElasticModel::Linear(LinearElastic {
-            parameters: elastic()?,
+    let solid = |m: &SolidSpec| elastic(m.young, m.poisson);
+    Ok(match spec {
+        MaterialSpec::LinearElastic(m) => Model::Elastic(ElasticModel::Linear(LinearElastic {
+            parameters: solid(m)?,
         })),
-        "neo-hookean" => Model::Elastic(ElasticModel::NeoHookean(NeoHookean {
-            parameters: elastic()?,
+        MaterialSpec::NeoHookean(m) => Model::Elastic(ElasticModel::NeoHookean(NeoHookean {
+            parameters: solid(m)?,
         })),
-        "st-venant-kirchhoff" => {
+        MaterialSpec::StVenantKirchhoff(m) => {
             Model::Elastic(ElasticModel::StVenantKirchhoff(StVenantKirchhoff {
-                parameters: elastic()?,
+                parameters: solid(m)?,
             }))
         }
-        "fixed-corotated" => Model::Elastic(ElasticModel::Corotated(FixedCorotated {
-            parameters: elastic()?,
-        })),
-        "fluid" => Model::Elastic(ElasticModel::Fluid(
-            WeaklyCompressibleFluid::new(need(m.bulk, "bulk")?, m.gamma.unwrap_or(7.0))
-                .map_err(|e| bad("bulk", e))?,
+        MaterialSpec::FixedCorotated(m) => {
+            Model::Elastic(ElasticModel::Corotated(FixedCorotated {
+                parameters: solid(m)?,
+            }))
+        }
+        MaterialSpec::Fluid(m) => Model::Elastic(ElasticModel::Fluid(
+            WeaklyCompressibleFluid::new(m.bulk, m.gamma.unwrap_or(7.0)).map_err(bad)?,
         )),
-        "drucker-prager" => {
+        MaterialSpec::DruckerPrager(m) => {
             let criterion = DruckerPrager::from_mohr_coulomb(
-                need(m.cohesion, "cohesion")?,
-                degrees(need(m.friction_angle, "friction_angle")?),
-                degrees(m.dilatancy_angle.unwrap_or(0.0)),
+                m.cohesion,
+                m.friction_angle.to_radians(),
+                m.dilatancy_angle.unwrap_or(0.0).to_radians(),
                 ConeFit::PlaneStrain,
             )
-            .map_err(|e| bad("friction_angle", e))?;
+            .map_err(bad)?;
             Model::Plastic(PlasticModel::DruckerPrager(ElastoPlastic::new(
-                elastic()?,
+                elastic(m.young, m.poisson)?,
                 criterion,
             )))
         }
-        "von-mises" => {
-            let criterion = VonMises::new(
-                need(m.yield_stress, "yield_stress")?,
-                m.hardening.unwrap_or(0.0),
-            )
-            .map_err(|e| bad("yield_stress", e))?;
+        MaterialSpec::VonMises(m) => {
+            let criterion =
+                VonMises::new(m.yield_stress, m.hardening.unwrap_or(0.0)).map_err(bad)?;
             Model::Plastic(PlasticModel::VonMises(ElastoPlastic::new(
-                elastic()?,
+                elastic(m.young, m.poisson)?,
                 criterion,
             )))
-        }
-        other => {
-            return Err(scene.value_error(
-                key("model"),
-                format!(
-                    "`{other}`: expected linear-elastic, neo-hookean, st-venant-kirchhoff, fixed-corotated, fluid, drucker-prager or von-mises"
-                ),
-            ));
         }
     })
 }
@@ -328,7 +311,7 @@ fn seed_body<const D: usize>(
 ) -> Result<Option<String>> {
     let body = &scene.spec.bodies[index];
     let key = |field: &str| format!("bodies[{index}].{field}");
-    let density = scene.spec.materials[material as usize].density;
+    let density = scene.spec.materials[material as usize].density();
     let mut cells: Option<&[u32]> = None;
     let region: Region<D> = match &body.region {
         None | Some(RegionSpec::Everywhere(true)) => Region::Everywhere,
@@ -394,15 +377,9 @@ fn seed_body<const D: usize>(
                 .collect()
         }
         SeedingSpec::Mesh(rule) => {
-            let rule = match rule.as_str() {
-                "centroid" => SampleRule::Centroid,
-                "gauss2" => SampleRule::Gauss2,
-                other => {
-                    return Err(scene.value_error(
-                        key("seeding.mesh"),
-                        format!("`{other}`: expected centroid or gauss2"),
-                    ));
-                }
+            let rule = match rule {
+                QuadratureSpec::Centroid => SampleRule::Centroid,
+                QuadratureSpec::Gauss2 => SampleRule::Gauss2,
             };
             let all = mesh.sample_points(rule);
             match cells {
@@ -496,7 +473,7 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
     let models = (0..spec.materials.len())
         .map(|i| material(scene, i))
         .collect::<Result<Vec<_>>>()?;
-    let material_names: Vec<String> = spec.materials.iter().map(|m| m.name.clone()).collect();
+    let material_names: Vec<String> = spec.materials.iter().map(|m| m.name().to_string()).collect();
     if spec.bodies.is_empty() {
         return Err(scene.value_error("bodies", "at least one body is needed"));
     }
@@ -564,15 +541,9 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
         None => SVector::zeros(),
         Some(g) => vector(scene, "scene.gravity", g)?,
     };
-    let stress_update = match spec.time.stress_update.as_deref().unwrap_or("usl") {
-        "usl" => StressUpdate::Usl,
-        "musl" => StressUpdate::Musl,
-        other => {
-            return Err(scene.value_error(
-                "time.stress_update",
-                format!("`{other}`: expected usl or musl"),
-            ));
-        }
+    let stress_update = match spec.time.stress_update {
+        StressUpdateSpec::Usl => StressUpdate::Usl,
+        StressUpdateSpec::Musl => StressUpdate::Musl,
     };
     let gravity_ramp = spec.scene.gravity_ramp.unwrap_or(0.0);
     if !(gravity_ramp.is_finite() && gravity_ramp >= 0.0) {

@@ -158,13 +158,44 @@ fn bad_values_name_their_key() {
             "colliding-disks",
             "young = 1000.0\n",
             "",
-            "`materials[0].young`",
+            "missing field `young`",
         ),
         (
             "colliding-disks",
             "model = \"linear-elastic\"",
             "model = \"jelly\"",
-            "`materials[0].model`",
+            "unknown variant `jelly`, expected one of `linear-elastic`",
+        ),
+        // A key of another model is an error, not ignored.
+        (
+            "colliding-disks",
+            "young = 1000.0",
+            "young = 1000.0\nyield_stress = 5.0",
+            "unknown field `yield_stress`, expected one of `name`, `density`, `young`, `poisson`",
+        ),
+        (
+            "colliding-disks",
+            "diagonal = \"alternating\"",
+            "diagonal = \"diagonal\"",
+            "unknown variant `diagonal`, expected one of `right`, `left`, `alternating`, `crossed`",
+        ),
+        (
+            "colliding-disks",
+            "[time]",
+            "[time]\nstress_update = \"usf\"",
+            "unknown variant `usf`, expected `usl` or `musl`",
+        ),
+        (
+            "colliding-disks",
+            "[output]",
+            "[output]\nencoding = \"base64\"",
+            "unknown variant `base64`, expected `binary` or `ascii`",
+        ),
+        (
+            "vibrating-bar",
+            "seeding = { mesh = \"centroid\" }",
+            "seeding = { mesh = \"gauss3\" }",
+            "unknown variant `gauss3`, expected `centroid` or `gauss2`",
         ),
         (
             "colliding-disks",
@@ -235,6 +266,10 @@ fn bad_values_name_their_key() {
     ] {
         let m = message(scene, find, replace);
         assert!(m.contains(key), "{scene}: `{replace}` gave: {m}");
+        // Errors the TOML reader finds also point at the line.
+        if key.starts_with("unknown") || key.starts_with("missing") {
+            assert!(m.contains("edited.toml: TOML parse error at line"), "{m}");
+        }
     }
 }
 
