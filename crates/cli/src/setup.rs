@@ -473,7 +473,11 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
     let models = (0..spec.materials.len())
         .map(|i| material(scene, i))
         .collect::<Result<Vec<_>>>()?;
-    let material_names: Vec<String> = spec.materials.iter().map(|m| m.name().to_string()).collect();
+    let material_names: Vec<String> = spec
+        .materials
+        .iter()
+        .map(|m| m.name().to_string())
+        .collect();
     if spec.bodies.is_empty() {
         return Err(scene.value_error("bodies", "at least one body is needed"));
     }

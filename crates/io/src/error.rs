@@ -139,7 +139,7 @@ pub enum IoError {
     },
     /// A node of a D < 3 mesh lies off the coordinate plane (or line) the mesh is read in.
     #[error(
-        "node {node} has coordinate {value} on axis {axis}; a {dimension}D mesh must lie in the plane (or on the line) where the remaining coordinates are 0"
+        "node {node} has coordinate {value:.6e} on axis {axis}; a {dimension}D mesh must lie in the plane (or on the line) where the remaining coordinates are 0"
     )]
     NotFlat {
         /// Node tag.

@@ -64,7 +64,7 @@ pub enum MeshError {
     },
     /// A simplex with (numerically) zero volume.
     #[error(
-        "simplex {simplex} is degenerate: signed volume {volume:e} is below the tolerance {tolerance:e}"
+        "simplex {simplex} is degenerate: signed volume {volume:.4e} is below the tolerance {tolerance:.4e}"
     )]
     DegenerateSimplex {
         /// Simplex index.
@@ -75,7 +75,7 @@ pub enum MeshError {
         tolerance: f64,
     },
     /// A simplex with negative orientation, under [`crate::Orientation::Reject`].
-    #[error("simplex {simplex} is inverted: signed volume {volume:e} < 0")]
+    #[error("simplex {simplex} is inverted: signed volume {volume:.4e} < 0")]
     InvertedSimplex {
         /// Simplex index.
         simplex: usize,

@@ -45,7 +45,7 @@ pub enum MlsError {
         gradients: usize,
     },
     /// A weight that is negative or not finite.
-    #[error("sample {sample} has invalid weight {weight}")]
+    #[error("sample {sample} has invalid weight {weight:.4e}")]
     InvalidWeight {
         /// Sample index.
         sample: usize,
@@ -54,7 +54,7 @@ pub enum MlsError {
     },
     /// The evaluation point lies outside the host simplex it was given with.
     #[error(
-        "point lies outside simplex {simplex} (smallest barycentric coordinate {min_barycentric:e})"
+        "point lies outside simplex {simplex} (smallest barycentric coordinate {min_barycentric:.4e})"
     )]
     OutsideHost {
         /// The simplex.
