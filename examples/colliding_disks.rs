@@ -13,12 +13,12 @@
 //! E = 1000, ν = 0.3, ρ = 1000, 4 particles per 0.05² cell, FLIP 0.99, Δt = 10⁻³, T = 3.
 
 use nalgebra::Vector2;
-use plotters::prelude::*;
 use std::error::Error;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use umls::constitutive::LinearElastic;
 use umls::engine::{Diagnostics, Flip, Simulation};
+use umls::io::chart::{Axis, LineChart, Series};
 use umls::kernels::{LinearFeKernel, Umls2};
 use umls::scenes::colliding_disks::CollidingDisks;
 use umls::transfer::Kernel;
@@ -180,95 +180,41 @@ fn plot_energies(
     umls: &[Diagnostics<2>],
     fe: &[Diagnostics<2>],
 ) -> Result<(), Box<dyn Error>> {
-    let root = SVGBackend::new(path, (1000, 560)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let top = umls
-        .iter()
-        .chain(fe)
-        .map(|d| d.total_energy())
-        .fold(0.0, f64::max)
-        * 1.1;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            "Colliding disks: energies (solid UMLS, dashed linear FE)",
-            ("sans-serif", 22),
-        )
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..3.0, 0.0..top)?;
-    chart
-        .configure_mesh()
-        .x_desc("time")
-        .y_desc("energy")
-        .draw()?;
     type Pick = fn(&Diagnostics<2>) -> f64;
-    let curves: [(&str, RGBColor, Pick); 3] = [
-        ("kinetic", BLUE, |d| d.kinetic),
-        ("strain", RED, |d| d.elastic),
-        ("total", BLACK, |d| d.total_energy()),
+    let curves: [(&str, Pick); 3] = [
+        ("kinetic", |d| d.kinetic),
+        ("strain", |d| d.elastic),
+        ("total", |d| d.total_energy()),
     ];
-    for (label, color, pick) in curves {
-        chart
-            .draw_series(LineSeries::new(
-                umls.iter().map(|d| (d.time, pick(d))),
-                color.stroke_width(2),
-            ))?
-            .label(label)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-            });
-        chart.draw_series(DashedLineSeries::new(
-            fe.iter().map(|d| (d.time, pick(d))),
-            6,
-            4,
-            color.stroke_width(1),
-        ))?;
+    let mut series = Vec::new();
+    for (kernel, history) in [("UMLS", umls), ("linear FE", fe)] {
+        for (label, pick) in curves {
+            series.push(Series::new(
+                format!("{label}, {kernel}"),
+                history.iter().map(|d| (d.time, pick(d))).collect(),
+            ));
+        }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
-    root.present()?;
+    LineChart {
+        title: "Colliding disks: energies".into(),
+        x: Axis::linear("time t [s]"),
+        y: Axis::linear("energy per unit thickness [J/m]"),
+        series,
+    }
+    .write_svg(path)?;
     Ok(())
 }
 
 fn plot_stress(path: &Path, umls: &[(f64, f64)], fe: &[(f64, f64)]) -> Result<(), Box<dyn Error>> {
-    let root = SVGBackend::new(path, (1000, 560)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let (lo, hi) = umls
-        .iter()
-        .chain(fe)
-        .fold((0.0f64, 0.0f64), |(lo, hi), t| (lo.min(t.1), hi.max(t.1)));
-    let pad = 0.05 * (hi - lo).max(1e-12);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            "Mean stress of one particle crossing facets: cell-crossing noise",
-            ("sans-serif", 22),
-        )
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(0.0..3.0, (lo - pad)..(hi + pad))?;
-    chart
-        .configure_mesh()
-        .x_desc("time")
-        .y_desc("tr τ / 2")
-        .draw()?;
-    for (label, color, data) in [("linear FE", RED, fe), ("UMLS", BLUE, umls)] {
-        chart
-            .draw_series(LineSeries::new(data.iter().copied(), color.stroke_width(2)))?
-            .label(label)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-            });
+    LineChart {
+        title: "Mean stress of one particle crossing facets: cell-crossing noise".into(),
+        x: Axis::linear("time t [s]"),
+        y: Axis::linear("mean Kirchhoff stress tr τ / 2 [Pa]"),
+        series: vec![
+            Series::new("linear FE", fe.to_vec()),
+            Series::new("UMLS", umls.to_vec()),
+        ],
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
-    root.present()?;
+    .write_svg(path)?;
     Ok(())
 }

@@ -14,7 +14,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use nalgebra::Vector2;
-use plotters::prelude::*;
+use umls::io::chart::{Axis, LineChart, Series};
 use umls::mesh::SimplexMesh;
 use umls::mesh::generate::{Diagonal, Lattice};
 use umls::mls::{GradientKind, Linear, Stencil, UmlsKernel};
@@ -184,52 +184,18 @@ fn main() -> Result<(), Box<dyn Error>> {
 /// One profile sample: (s, exact, UMLS, linear FE).
 type Row = (f64, f64, f64, f64);
 
-/// A curve of the chart: label, colour, and which column of a row it plots.
-type Series = (&'static str, RGBColor, fn(&Row) -> f64);
-
 fn plot(path: &std::path::Path, rows: &[Row]) -> Result<(), Box<dyn Error>> {
-    let root = SVGBackend::new(path, (1000, 560)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let (lo, hi) = rows
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
-            (lo.min(r.1.min(r.2).min(r.3)), hi.max(r.1.max(r.2).max(r.3)))
-        });
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            "∂f/∂x along a line crossing ~60 facets: UMLS vs linear FE",
-            ("sans-serif", 22),
-        )
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(rows[0].0..rows[rows.len() - 1].0, (lo - 0.3)..(hi + 0.3))?;
-    chart
-        .configure_mesh()
-        .x_desc("arc-length parameter s")
-        .y_desc("∂f/∂x")
-        .draw()?;
-    let series: [Series; 3] = [
-        ("exact", BLACK, |r| r.1),
-        ("linear FE", RED, |r| r.3),
-        ("UMLS (reconstructed gradient)", BLUE, |r| r.2),
-    ];
-    for (label, color, pick) in series {
-        chart
-            .draw_series(LineSeries::new(
-                rows.iter().map(|r| (r.0, pick(r))),
-                color.stroke_width(2),
-            ))?
-            .label(label)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-            });
+    let column = |pick: fn(&Row) -> f64| rows.iter().map(|r| (r.0, pick(r))).collect();
+    LineChart {
+        title: "∂f/∂x along a line crossing ~60 facets: UMLS vs linear FE".into(),
+        x: Axis::linear("arc-length parameter s [-]"),
+        y: Axis::linear("∂f/∂x [-]"),
+        series: vec![
+            Series::new("exact", column(|r| r.1)),
+            Series::new("linear FE", column(|r| r.3)),
+            Series::new("UMLS (reconstructed)", column(|r| r.2)),
+        ],
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
-    root.present()?;
+    .write_svg(path)?;
     Ok(())
 }

@@ -7,7 +7,7 @@
 //! - `umls mesh-info FILE.msh` describes a Gmsh mesh ([`mesh_info`]).
 //!
 //! Dependencies beyond the workspace's: `clap` (argument parsing and `--help`),
-//! `indicatif` (progress bar), `plotters` (the energy plot), `toml` + `serde` (scene files, with unknown keys
+//! `indicatif` (progress bar), `toml` + `serde` (scene files, with unknown keys
 //! rejected), `serde_json` (the run summary), `exmex` (velocity expressions such as
 //! `"0.1 * sin(PI * x / 50)"`) and `ctrlc` (Ctrl-C ends a run with its output written,
 //! portably across platforms): each a maintained crate that does its job better than a

@@ -1,9 +1,10 @@
 //! `energies.svg`: the energy history of a run as a picture any browser opens, for a
-//! first look without ParaView (plotters, the workspace's plotting crate).
+//! first look without ParaView (drawn by `umls_io::chart`, the project's one chart
+//! helper).
 
 use std::path::Path;
 
-use plotters::prelude::*;
+use umls_io::chart::{Axis, LineChart, Series};
 
 use crate::error::{CliError, Result};
 
@@ -22,75 +23,40 @@ pub struct EnergyRecord {
     pub total: f64,
 }
 
-fn draw(
-    path: &Path,
-    title: &str,
-    records: &[EnergyRecord],
-    with_potential: bool,
-) -> std::result::Result<(), Box<dyn std::error::Error>> {
-    let root = SVGBackend::new(path, (1000, 560)).into_drawing_area();
-    root.fill(&WHITE)?;
-    type Pick = fn(&EnergyRecord) -> f64;
-    let mut curves: Vec<(&str, RGBColor, Pick)> = vec![
-        ("kinetic", BLUE, |r| r.kinetic),
-        ("elastic", RED, |r| r.elastic),
-        ("total", BLACK, |r| r.total),
-    ];
-    if with_potential {
-        curves.insert(2, ("potential", GREEN, |r| r.potential));
-    }
-    let (mut low, mut high) = (0.0f64, 0.0f64);
-    for r in records {
-        for (_, _, pick) in &curves {
-            low = low.min(pick(r));
-            high = high.max(pick(r));
-        }
-    }
-    let pad = 0.05 * (high - low).max(f64::MIN_POSITIVE);
-    let end = records
-        .last()
-        .map_or(1.0, |r| r.time)
-        .max(f64::MIN_POSITIVE);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(0.0..end, (low - pad)..(high + pad))?;
-    chart
-        .configure_mesh()
-        .x_desc("time")
-        .y_desc("energy")
-        .draw()?;
-    for (label, color, pick) in curves {
-        chart
-            .draw_series(LineSeries::new(
-                records.iter().map(|r| (r.time, pick(r))),
-                color.stroke_width(2),
-            ))?
-            .label(label)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-            });
-    }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
-    root.present()?;
-    Ok(())
-}
-
 /// Writes the energy history to `path` as SVG; the potential curve appears for scenes
-/// with gravity.
+/// with gravity. Energies of a D-dimensional scene are per unit thickness (2D) or per
+/// unit cross-section (1D), and the axis says so.
 pub fn energy_plot(
     path: &Path,
     title: &str,
+    dimension: usize,
     records: &[EnergyRecord],
     with_potential: bool,
 ) -> Result<()> {
-    draw(path, title, records, with_potential).map_err(|e| CliError::Plot {
+    let curve = |label: &str, pick: fn(&EnergyRecord) -> f64| {
+        Series::new(label, records.iter().map(|r| (r.time, pick(r))).collect())
+    };
+    let mut series = vec![
+        curve("kinetic", |r| r.kinetic),
+        curve("elastic", |r| r.elastic),
+    ];
+    if with_potential {
+        series.push(curve("potential (from start)", |r| r.potential));
+    }
+    series.push(curve("total", |r| r.total));
+    let unit = match dimension {
+        1 => "J/m²",
+        2 => "J/m",
+        _ => "J",
+    };
+    LineChart {
+        title: title.to_string(),
+        x: Axis::linear("time t [s]"),
+        y: Axis::linear(format!("energy [{unit}]")),
+        series,
+    }
+    .write_svg(path)
+    .map_err(|e| CliError::Plot {
         path: path.to_path_buf(),
         message: e.to_string(),
     })

@@ -555,6 +555,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
             ctx.kernel.name(),
             transfer_name(&spec.transfer)
         ),
+        D,
         &energies,
         setup.gravity.norm() > 0.0,
     )?;

@@ -186,6 +186,14 @@ pub enum IoError {
         /// Values expected.
         expected: usize,
     },
+    /// A chart could not be drawn or written.
+    #[error("{path}: cannot draw the chart: {message}")]
+    Chart {
+        /// The SVG file.
+        path: PathBuf,
+        /// What the plotting backend reported.
+        message: String,
+    },
 }
 
 /// Shorthand.

@@ -6,8 +6,13 @@
 //! - [`vtk`]: write `.vtu` files (particles as point clouds with fields, meshes with
 //!   node and cell fields) and `.pvd` collections that ParaView opens as an animation.
 //! - [`csv`]: write time histories with a header row.
+//! - [`chart`]: line charts as SVG, with titles, axis labels that carry units, optional
+//!   log axes and a legend beside the plot, shared by the command line, the examples and
+//!   the bench report.
 //!
-//! The `base64` crate encodes binary VTK arrays (a well-kept, dependency-free encoder).
+//! The `base64` crate encodes binary VTK arrays (a well-kept, dependency-free encoder);
+//! `plotters` (SVG backend only) draws the charts, which would be a great deal of
+//! hand-written SVG geometry otherwise.
 //!
 //! ```
 //! use umls_io::gmsh::{parse_msh, ReadOptions};
@@ -27,6 +32,7 @@
 //! # Ok::<(), umls_io::IoError>(())
 //! ```
 
+pub mod chart;
 pub mod csv;
 mod error;
 pub mod gmsh;
