@@ -30,7 +30,6 @@
 pub mod builtin;
 mod error;
 pub mod expression;
-pub mod material;
 pub mod mesh_info;
 mod output;
 pub mod plot;

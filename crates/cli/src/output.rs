@@ -12,7 +12,7 @@ use umls_mesh::SimplexMesh;
 use umls_transfer::Kernel;
 
 use crate::error::{CliError, Result};
-use crate::material::{MaterialTable, PlasticPart};
+use umls_constitutive::table::{MaterialTable, PlasticPart};
 
 /// The output directory of a run.
 #[derive(Debug)]

@@ -2,7 +2,9 @@
 //! transfer types, step to the end time and write the output.
 //!
 //! Each (dimension, kernel, transfer, plasticity) combination is its own monomorphized
-//! simulation, so a run executes exactly the code its scene needs.
+//! simulation, so a run steps with exactly the code its scene needs. The run loop around
+//! it (time step, boundaries, output, history, summary) sees the simulation through the
+//! object-safe [`Run`] trait and is compiled once per dimension.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -11,8 +13,8 @@ use std::time::Instant;
 use nalgebra::SVector;
 use serde_json::json;
 use umls_engine::{
-    Apic, Diagnostics, Flip, Particles, Pic, Simulation, StepSettings, TimeStepControl,
-    TransferScheme, VelocityGradientAffine, Wall, WallKind,
+    Apic, Boundary, Diagnostics, EngineError, Flip, Particles, Pic, Simulation, StepSettings,
+    TimeStepControl, TransferScheme, VelocityGradientAffine, Wall, WallKind,
 };
 use umls_io::csv::HistoryWriter;
 use umls_io::vtk::Encoding;
@@ -21,13 +23,15 @@ use umls_mesh::SimplexMesh;
 use umls_transfer::Kernel;
 
 use crate::error::{CliError, Result};
-use crate::material::{MaterialTable, Model, NoPlasticity, PlasticModel, PlasticPart, TableState};
 use crate::output::OutputDir;
 use crate::plot::EnergyRecord;
 use crate::progress::Progress;
 use crate::scene::Scene;
 use crate::schema::{BoundaryKind, EncodingSpec, KernelKind, TransferKind};
 use crate::setup::{self, BoundaryTarget, Setup, Split};
+use umls_constitutive::table::{
+    MaterialTable, Model, NoPlasticity, PlasticModel, PlasticPart, TableState,
+};
 
 /// Command-line overrides and output settings of a run.
 #[derive(Debug, Clone)]
@@ -193,7 +197,6 @@ const MAX_GRID_NODES: f64 = 1e8;
 /// A B-spline grid covering the mesh's bounding box with two cells of margin (the
 /// widest, cubic, stencil needs one).
 fn bspline<const D: usize>(ctx: &Context<'_, D>, order: BSplineOrder) -> Result<BSplineKernel<D>> {
-    const MARGIN: usize = 2;
     let mesh = &ctx.setup.mesh;
     let h = ctx
         .scene
@@ -208,21 +211,18 @@ fn bspline<const D: usize>(ctx: &Context<'_, D>, order: BSplineOrder) -> Result<
             .value_error("kernel.grid_spacing", "must be positive"));
     }
     let (lower, upper) = mesh.bounding_box();
-    let origin = lower.add_scalar(-(MARGIN as f64) * h);
-    let cells: [usize; D] = std::array::from_fn(|k| {
-        ((upper[k] - lower[k]) / h - 1e-9).ceil().max(1.0) as usize + 2 * MARGIN
-    });
-    let nodes: f64 = cells.iter().map(|&n| n as f64 + 1.0).product();
+    let kernel = BSplineKernel::covering(lower, upper, h, order).ok_or_else(|| {
+        ctx.scene
+            .value_error("kernel.grid_spacing", "too coarse for one B-spline stencil")
+    })?;
+    let nodes: f64 = kernel.cells().iter().map(|&n| n as f64 + 1.0).product();
     if nodes > MAX_GRID_NODES {
         return Err(ctx.scene.value_error(
             "kernel.grid_spacing",
             format!("{h} gives a grid of {nodes:.3e} nodes (limit {MAX_GRID_NODES:.0e})"),
         ));
     }
-    BSplineKernel::new(origin, h, cells, order).ok_or_else(|| {
-        ctx.scene
-            .value_error("kernel.grid_spacing", "too coarse for one B-spline stencil")
-    })
+    Ok(kernel)
 }
 
 fn with_kernel<const D: usize, X: Dimension<D>, K: Kernel<D>>(
@@ -251,10 +251,125 @@ fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
 ) -> Result<RunReport> {
     let t = &ctx.scene.spec.transfer;
     match t.kind {
-        TransferKind::Pic => simulate(ctx, kernel, table, Pic),
-        TransferKind::Flip => simulate(ctx, kernel, table, Flip { alpha: t.alpha }),
-        TransferKind::Apic => simulate(ctx, kernel, table, Apic),
-        TransferKind::VelocityGradient => simulate(ctx, kernel, table, VelocityGradientAffine),
+        TransferKind::Pic => start(ctx, kernel, table, Pic),
+        TransferKind::Flip => start(ctx, kernel, table, Flip { alpha: t.alpha }),
+        TransferKind::Apic => start(ctx, kernel, table, Apic),
+        TransferKind::VelocityGradient => start(ctx, kernel, table, VelocityGradientAffine),
+    }
+}
+
+/// The typed part of a run: particles of the table's state and the kernel's cache, and
+/// the simulation, handed to the run loop as a [`Run`].
+fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
+    ctx: &Context<'_, D>,
+    kernel: K,
+    table: MaterialTable<P>,
+    transfer: T,
+) -> Result<RunReport> {
+    let seeds = &ctx.setup.seeds;
+    let mut particles = Particles::<D, TableState<P::State>, K::Cache>::at_rest(
+        seeds.position.clone(),
+        seeds.volume.clone(),
+        1.0,
+        TableState::default(),
+    );
+    particles.mass.clone_from(&seeds.mass);
+    particles.velocity.clone_from(&seeds.velocity);
+    for (state, &m) in particles.state.iter_mut().zip(&seeds.material) {
+        state.material = m;
+    }
+    let mut settings = StepSettings::new(1.0);
+    settings.gravity = ctx.setup.gravity;
+    settings.gravity_ramp = ctx.setup.gravity_ramp;
+    settings.stress_update = ctx.setup.stress_update;
+    settings.damping = ctx.setup.damping;
+    let mut sim = Simulation::new(kernel, table, transfer, particles, settings)?;
+    drive(ctx, &mut sim)
+}
+
+/// What the run loop needs of a simulation. Object-safe, so [`drive`] is compiled once
+/// per dimension; only [`Run::step`] and the output of particle fields are compiled for
+/// each kernel, material table and transfer, which is where the time goes.
+trait Run<const D: usize> {
+    fn step(&mut self) -> std::result::Result<(), EngineError>;
+    fn time(&self) -> f64;
+    fn step_count(&self) -> usize;
+    fn diagnostics(&self) -> std::result::Result<Diagnostics<D>, EngineError>;
+    fn settings(&self) -> &StepSettings<D>;
+    fn settings_mut(&mut self) -> &mut StepSettings<D>;
+    fn stable_time_step(&self, cfl: f64) -> f64;
+    fn set_geostatic_stress(&mut self, k0: f64) -> std::result::Result<(), EngineError>;
+    fn spacing(&self) -> f64;
+    /// Adds a wall; the number of nodes it constrains.
+    fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> usize;
+    fn boundary(&mut self) -> &mut Boundary<D>;
+    fn positions(&self) -> &[SVector<f64, D>];
+    fn velocities(&self) -> &[SVector<f64, D>];
+    fn write_particles(&self, out: &mut OutputDir, reference: &[SVector<f64, D>]) -> Result<()>;
+    fn grid(&self) -> (&[f64], &[SVector<f64, D>]);
+    fn node_positions(&self) -> Vec<SVector<f64, D>>;
+    fn node_count(&self) -> usize;
+    fn last_dt(&self) -> f64;
+}
+
+impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
+    for Simulation<D, K, MaterialTable<P>, T>
+{
+    fn step(&mut self) -> std::result::Result<(), EngineError> {
+        Simulation::step(self)
+    }
+    fn time(&self) -> f64 {
+        Simulation::time(self)
+    }
+    fn step_count(&self) -> usize {
+        Simulation::step_count(self)
+    }
+    fn diagnostics(&self) -> std::result::Result<Diagnostics<D>, EngineError> {
+        Simulation::diagnostics(self)
+    }
+    fn settings(&self) -> &StepSettings<D> {
+        &self.settings
+    }
+    fn settings_mut(&mut self) -> &mut StepSettings<D> {
+        &mut self.settings
+    }
+    fn stable_time_step(&self, cfl: f64) -> f64 {
+        Simulation::stable_time_step(self, cfl)
+    }
+    fn set_geostatic_stress(&mut self, k0: f64) -> std::result::Result<(), EngineError> {
+        Simulation::set_geostatic_stress(self, k0)
+    }
+    fn spacing(&self) -> f64 {
+        self.kernel.spacing()
+    }
+    fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> usize {
+        self.boundary.add_wall(&self.kernel, wall, tolerance)
+    }
+    fn boundary(&mut self) -> &mut Boundary<D> {
+        &mut self.boundary
+    }
+    fn positions(&self) -> &[SVector<f64, D>] {
+        &self.particles.position
+    }
+    fn velocities(&self) -> &[SVector<f64, D>] {
+        &self.particles.velocity
+    }
+    fn write_particles(&self, out: &mut OutputDir, reference: &[SVector<f64, D>]) -> Result<()> {
+        out.write_particles(self, reference)
+    }
+    fn grid(&self) -> (&[f64], &[SVector<f64, D>]) {
+        Simulation::grid(self)
+    }
+    fn node_positions(&self) -> Vec<SVector<f64, D>> {
+        (0..self.kernel.node_count())
+            .map(|n| self.kernel.node_position(n))
+            .collect()
+    }
+    fn node_count(&self) -> usize {
+        self.kernel.node_count()
+    }
+    fn last_dt(&self) -> f64 {
+        Simulation::last_dt(self)
     }
 }
 
@@ -273,114 +388,19 @@ fn total_energy<const D: usize>(d: &Diagnostics<D>) -> (f64, f64) {
     (-d.external_work, d.energy_balance())
 }
 
-fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
-    ctx: &Context<'_, D>,
-    kernel: K,
-    table: MaterialTable<P>,
-    transfer: T,
-) -> Result<RunReport> {
+/// The run loop: time step, boundaries, output, history, summary.
+fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<RunReport> {
     let (scene, setup, spec) = (ctx.scene, &ctx.setup, &ctx.scene.spec);
     let seeds = &setup.seeds;
-    let mut particles = Particles::<D, TableState<P::State>, K::Cache>::at_rest(
-        seeds.position.clone(),
-        seeds.volume.clone(),
-        1.0,
-        TableState::default(),
-    );
-    particles.mass.clone_from(&seeds.mass);
-    particles.velocity.clone_from(&seeds.velocity);
-    for (state, &m) in particles.state.iter_mut().zip(&seeds.material) {
-        state.material = m;
-    }
-    let mut settings = StepSettings::new(1.0);
-    settings.gravity = setup.gravity;
-    settings.gravity_ramp = setup.gravity_ramp;
-    settings.stress_update = setup.stress_update;
-    settings.damping = setup.damping;
-    let mut sim = Simulation::new(kernel, table, transfer, particles, settings)?;
     if let Some(k0) = setup.geostatic_k0 {
         sim.set_geostatic_stress(k0)?;
     }
 
     let mut warnings = setup.warnings.clone();
     let stable_dt = sim.stable_time_step(1.0);
-    let target_dt = match (spec.time.dt, spec.time.cfl, spec.time.adaptive) {
-        (_, Some(cfl), true) => {
-            sim.settings.time_step = TimeStepControl::Adaptive { cfl };
-            spec.time
-                .dt
-                .unwrap_or(f64::INFINITY)
-                .min(sim.stable_time_step(cfl))
-        }
-        (Some(dt), _, _) => dt,
-        (_, Some(cfl), _) => sim.stable_time_step(cfl),
-        _ => unreachable_dt(scene)?,
-    };
-    let planned = ((ctx.end_time / target_dt) - 1e-9).ceil().max(1.0);
-    // A typo in end_time (1e12 for 1.2) should be an error, not a run of years.
-    const MAX_STEPS: f64 = 1e9;
-    if planned > MAX_STEPS {
-        return Err(scene.value_error(
-            "scene.end_time",
-            format!(
-                "{} with a time step of {target_dt:.4e} is {planned:.3e} steps (limit {MAX_STEPS:.0e})",
-                ctx.end_time
-            ),
-        ));
-    }
-    let steps = planned as usize;
-    let dt_cap = match sim.settings.time_step {
-        TimeStepControl::Adaptive { .. } => spec.time.dt.unwrap_or(ctx.end_time),
-        TimeStepControl::Fixed => ctx.end_time / steps as f64,
-    };
-    sim.settings.dt = dt_cap;
-    if sim.settings.time_step == TimeStepControl::Fixed && sim.settings.dt > stable_dt {
-        warnings.push(format!(
-            "time.dt = {:.4e} exceeds the stable step {stable_dt:.4e} (wave Courant number {:.3} > 1): expect the run to blow up",
-            sim.settings.dt,
-            sim.settings.dt / stable_dt
-        ));
-    }
-
+    let (steps, dt_cap) = plan_time_step(ctx, sim, stable_dt, &mut warnings)?;
     let mesh_kernel = matches!(ctx.kernel, KernelKind::Umls | KernelKind::LinearFe);
-    for (i, (kind, target)) in setup.boundaries.iter().enumerate() {
-        let wall_kind = match kind {
-            BoundaryKind::Fixed => WallKind::Fixed,
-            BoundaryKind::Slip => WallKind::Slip,
-        };
-        match target {
-            BoundaryTarget::Plane { point, normal } => {
-                let tolerance = 1e-6 * sim.kernel.spacing();
-                let wall = Wall::facing(wall_kind, *point, *normal, &sim.particles.position)
-                    .ok_or_else(|| {
-                        scene.value_error(
-                            format!("boundaries[{i}].plane.normal"),
-                            "must not be zero",
-                        )
-                    })?;
-                if sim.boundary.add_wall(&sim.kernel, wall, tolerance) == 0 {
-                    return Err(scene.value_error(
-                        format!("boundaries[{i}].plane"),
-                        format!("no {} node lies on or beyond the plane", ctx.kernel.name()),
-                    ));
-                }
-            }
-            BoundaryTarget::Vertices(vertices) => {
-                if !mesh_kernel {
-                    return Err(scene.value_error(
-                        format!("boundaries[{i}].group"),
-                        format!("a group condition needs mesh nodes; the {} kernel uses a grid (use a plane)", ctx.kernel.name()),
-                    ));
-                }
-                match kind {
-                    BoundaryKind::Fixed => {
-                        sim.boundary.fixed.extend(vertices.iter().map(|(v, _)| *v))
-                    }
-                    BoundaryKind::Slip => sim.boundary.slip.extend(vertices.iter().copied()),
-                }
-            }
-        }
-    }
+    apply_boundaries(ctx, sim)?;
     for w in &warnings {
         eprintln!("warning: {w}");
     }
@@ -415,7 +435,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     let frames = setup::frame_count(scene, ctx.end_time);
     let frame_time = |k: usize| ctx.end_time * k as f64 / (frames - 1) as f64;
     let mut next_frame = 1;
-    let record = |sim: &Simulation<D, K, MaterialTable<P>, T>,
+    let record = |sim: &dyn Run<D>,
                   history: &mut HistoryWriter,
                   error: Option<f64>|
      -> Result<(f64, Diagnostics<D>, EnergyRecord)> {
@@ -453,22 +473,22 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     };
 
     // The reference error at the current time: RMS over particles of |v − v_ref(X, t)|.
-    let reference_error = |sim: &Simulation<D, K, MaterialTable<P>, T>| -> Result<Option<f64>> {
+    let reference_error = |sim: &dyn Run<D>| -> Result<Option<f64>> {
         let Some((field, scale)) = &setup.reference else {
             return Ok(None);
         };
         let mut sum = 0.0;
-        for (v, x0) in sim.particles.velocity.iter().zip(&reference_positions) {
+        for (v, x0) in sim.velocities().iter().zip(&reference_positions) {
             let exact = field
                 .eval(x0, sim.time())
                 .map_err(|reason| scene.value_error("reference.velocity", reason))?;
             sum += (v - exact).norm_squared();
         }
-        Ok(Some((sum / sim.particles.len() as f64).sqrt() / scale))
+        Ok(Some((sum / sim.positions().len() as f64).sqrt() / scale))
     };
 
-    out.write_particles(&sim, &reference_positions)?;
-    let (e0, d0, r0) = record(&sim, &mut history, reference_error(&sim)?)?;
+    sim.write_particles(&mut out, &reference_positions)?;
+    let (e0, d0, r0) = record(&*sim, &mut history, reference_error(&*sim)?)?;
     let mut energies = vec![r0];
     // Energy error: the largest |E(t) − E(0)| over the largest mechanical energy
     // (kinetic + elastic) of the run, which stays meaningful when E(0) is 0 (a body
@@ -484,8 +504,8 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     let mut step = 0;
     while sim.time() < ctx.end_time * (1.0 - 1e-12) {
         step += 1;
-        if let TimeStepControl::Adaptive { .. } = sim.settings.time_step {
-            sim.settings.dt = dt_cap.min(ctx.end_time - sim.time());
+        if let TimeStepControl::Adaptive { .. } = sim.settings().time_step {
+            sim.settings_mut().dt = dt_cap.min(ctx.end_time - sim.time());
         }
         if ctx
             .options
@@ -503,14 +523,14 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
             failure = Some(e.into());
             break;
         }
-        let error = reference_error(&sim)?;
+        let error = reference_error(&*sim)?;
         if let Some(e) = error {
             error_sum += e * e;
             error_max = error_max.max(e);
         }
         let last_step = sim.time() >= ctx.end_time * (1.0 - 1e-12);
         if step % spec.output.history_every == 0 || last_step {
-            let (total, d, r) = record(&sim, &mut history, error)?;
+            let (total, d, r) = record(&*sim, &mut history, error)?;
             max_wave_courant = max_wave_courant.max(d.wave_courant);
             energies.push(r);
             energy_change = energy_change.max((total - e0).abs());
@@ -518,8 +538,8 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
             energy_scale = energy_scale.max(d.kinetic + d.elastic);
             last = d;
         }
-        if next_frame < frames && sim.time() >= frame_time(next_frame) - 0.5 * sim.settings.dt {
-            out.write_particles(&sim, &reference_positions)?;
+        if next_frame < frames && sim.time() >= frame_time(next_frame) - 0.5 * sim.settings().dt {
+            sim.write_particles(&mut out, &reference_positions)?;
             next_frame += 1;
         }
         progress.advance();
@@ -529,8 +549,8 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     if failure.is_some() {
         // The state the run stopped in (the last frame may be far behind it), and its
         // history row.
-        out.write_particles(&sim, &reference_positions)?;
-        if let Ok((total, d, r)) = record(&sim, &mut history, None) {
+        sim.write_particles(&mut out, &reference_positions)?;
+        if let Ok((total, d, r)) = record(&*sim, &mut history, None) {
             energies.push(r);
             last_total = total;
             last = d;
@@ -542,9 +562,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         out.write_mesh(&setup.mesh, &setup.groups, Some((mass, velocity)))?;
     } else {
         out.write_mesh(&setup.mesh, &setup.groups, None)?;
-        let nodes: Vec<SVector<f64, D>> = (0..sim.kernel.node_count())
-            .map(|n| sim.kernel.node_position(n))
-            .collect();
+        let nodes = sim.node_positions();
         out.write_grid(&nodes, mass, velocity)?;
     }
     crate::plot::energy_plot(
@@ -595,16 +613,16 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         "transfer": transfer_name(&spec.transfer),
         "stress_update": spec.time.stress_update.name(),
         "materials": setup.material_names,
-        "particles": sim.particles.len(),
-        "nodes": sim.kernel.node_count(),
+        "particles": sim.positions().len(),
+        "nodes": sim.node_count(),
         "cells": setup.mesh.simplex_count(),
         "dt": sim.last_dt(),
-        "time_step": match sim.settings.time_step {
+        "time_step": match sim.settings().time_step {
             TimeStepControl::Fixed => "fixed",
             TimeStepControl::Adaptive { .. } => "adaptive",
         },
         "stable_dt": stable_dt,
-        "dt_exceeds_stable": sim.settings.time_step == TimeStepControl::Fixed && sim.settings.dt > stable_dt,
+        "dt_exceeds_stable": sim.settings().time_step == TimeStepControl::Fixed && sim.settings().dt > stable_dt,
         "max_wave_courant": max_wave_courant,
         "warnings": warnings,
         "end_time": ctx.end_time,
@@ -618,7 +636,7 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
         },
         "error": failure.as_ref().map(|e| e.to_string()),
         "wall_time_s": wall,
-        "particle_steps_per_second": if wall > 0.0 { (sim.particles.len() * taken) as f64 / wall } else { 0.0 },
+        "particle_steps_per_second": if wall > 0.0 { (sim.positions().len() * taken) as f64 / wall } else { 0.0 },
         "metrics": metrics,
         "outputs": {
             "particles": "particles.pvd",
@@ -639,6 +657,102 @@ fn simulate<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
             out: ctx.options.out.clone(),
         }),
     }
+}
+
+/// The fixed step (or the cap of the adaptive one) and the planned number of steps;
+/// warns when a fixed step exceeds the stable one.
+fn plan_time_step<const D: usize>(
+    ctx: &Context<'_, D>,
+    sim: &mut dyn Run<D>,
+    stable_dt: f64,
+    warnings: &mut Vec<String>,
+) -> Result<(usize, f64)> {
+    let (scene, spec) = (ctx.scene, &ctx.scene.spec);
+    let target_dt = match (spec.time.dt, spec.time.cfl, spec.time.adaptive) {
+        (_, Some(cfl), true) => {
+            sim.settings_mut().time_step = TimeStepControl::Adaptive { cfl };
+            spec.time
+                .dt
+                .unwrap_or(f64::INFINITY)
+                .min(sim.stable_time_step(cfl))
+        }
+        (Some(dt), _, _) => dt,
+        (_, Some(cfl), _) => sim.stable_time_step(cfl),
+        _ => unreachable_dt(scene)?,
+    };
+    let planned = ((ctx.end_time / target_dt) - 1e-9).ceil().max(1.0);
+    // A typo in end_time (1e12 for 1.2) should be an error, not a run of years.
+    const MAX_STEPS: f64 = 1e9;
+    if planned > MAX_STEPS {
+        return Err(scene.value_error(
+            "scene.end_time",
+            format!(
+                "{} with a time step of {target_dt:.4e} is {planned:.3e} steps (limit {MAX_STEPS:.0e})",
+                ctx.end_time
+            ),
+        ));
+    }
+    let steps = planned as usize;
+    let dt_cap = match sim.settings().time_step {
+        TimeStepControl::Adaptive { .. } => spec.time.dt.unwrap_or(ctx.end_time),
+        TimeStepControl::Fixed => ctx.end_time / steps as f64,
+    };
+    sim.settings_mut().dt = dt_cap;
+    if sim.settings().time_step == TimeStepControl::Fixed && sim.settings().dt > stable_dt {
+        warnings.push(format!(
+            "time.dt = {:.4e} exceeds the stable step {stable_dt:.4e} (wave Courant number {:.3} > 1): expect the run to blow up",
+            sim.settings().dt,
+            sim.settings().dt / stable_dt
+        ));
+    }
+
+    Ok((steps, dt_cap))
+}
+
+/// Walls on planes, and fixed or slip conditions on the nodes of mesh groups.
+fn apply_boundaries<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<()> {
+    let scene = ctx.scene;
+    let mesh_kernel = matches!(ctx.kernel, KernelKind::Umls | KernelKind::LinearFe);
+    for (i, (kind, target)) in ctx.setup.boundaries.iter().enumerate() {
+        let wall_kind = match kind {
+            BoundaryKind::Fixed => WallKind::Fixed,
+            BoundaryKind::Slip => WallKind::Slip,
+        };
+        match target {
+            BoundaryTarget::Plane { point, normal } => {
+                let tolerance = 1e-6 * sim.spacing();
+                let wall =
+                    Wall::facing(wall_kind, *point, *normal, sim.positions()).ok_or_else(|| {
+                        scene.value_error(
+                            format!("boundaries[{i}].plane.normal"),
+                            "must not be zero",
+                        )
+                    })?;
+                if sim.add_wall(wall, tolerance) == 0 {
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].plane"),
+                        format!("no {} node lies on or beyond the plane", ctx.kernel.name()),
+                    ));
+                }
+            }
+            BoundaryTarget::Vertices(vertices) => {
+                if !mesh_kernel {
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].group"),
+                        format!("a group condition needs mesh nodes; the {} kernel uses a grid (use a plane)", ctx.kernel.name()),
+                    ));
+                }
+                match kind {
+                    BoundaryKind::Fixed => sim
+                        .boundary()
+                        .fixed
+                        .extend(vertices.iter().map(|(v, _)| *v)),
+                    BoundaryKind::Slip => sim.boundary().slip.extend(vertices.iter().copied()),
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// `check_header` guarantees a time step setting; this keeps the match total without a panic.

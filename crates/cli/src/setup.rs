@@ -15,12 +15,12 @@ use umls_mesh::{Orientation, SampleRule, SimplexMesh};
 
 use crate::error::{CliError, Result};
 use crate::expression::VectorField;
-use crate::material::{ElasticModel, Model, PlasticModel};
 use crate::scene::Scene;
 use crate::schema::{
     BoundaryKind, DiagonalSpec, MaterialSpec, QuadratureSpec, RegionSpec, SeedingSpec, SolidSpec,
     StressUpdateSpec,
 };
+use umls_constitutive::table::{ElasticModel, Model, PlasticModel};
 
 /// Most lattice points a seeding may generate before filtering by region, and most cells
 /// of a generated lattice mesh: a typo in a spacing or count should be an error, not an

@@ -16,6 +16,10 @@
 //! | Drucker–Prager (Hencky) | [`ElastoPlastic`]`<`[`DruckerPrager`]`>` | [`PlasticState`] |
 //! | von Mises + hardening (Hencky) | [`ElastoPlastic`]`<`[`VonMises`]`>` | [`PlasticState`] |
 //!
+//! [`table::MaterialTable`] puts several of them in one simulation (a material id per
+//! particle); its plastic part is a type parameter, so a table without plastic models
+//! carries no plastic state.
+//!
 //! Parameters are validated on construction ([`ElasticParameters`]): E > 0,
 //! −1 < ν < 0.5, angles in range; errors name the parameter and its value.
 //!
@@ -40,6 +44,7 @@ mod linalg;
 mod model;
 mod parameters;
 mod plastic;
+pub mod table;
 mod yield_criteria;
 
 pub use elastic::{FixedCorotated, LinearElastic, NeoHookean, StVenantKirchhoff};

@@ -93,6 +93,36 @@ impl<const D: usize> BSplineKernel<D> {
         })
     }
 
+    /// The grid of spacing `h` covering the box [lower, upper] with
+    /// [`Self::COVER_MARGIN`] extra cells on every side: a particle on the box boundary
+    /// keeps its whole stencil, and walls there get their node layers. `None` for h ≤ 0 or
+    /// non-finite input.
+    pub fn covering(
+        lower: SVector<f64, D>,
+        upper: SVector<f64, D>,
+        h: f64,
+        order: BSplineOrder,
+    ) -> Option<Self> {
+        if !(h.is_finite() && h > 0.0) || lower.iter().chain(upper.iter()).any(|x| !x.is_finite()) {
+            return None;
+        }
+        let margin = Self::COVER_MARGIN;
+        let origin = lower.add_scalar(-(margin as f64) * h);
+        // `as usize` saturates: an absurd ratio gives a huge count the caller can refuse.
+        let cells: [usize; D] = std::array::from_fn(|k| {
+            (((upper[k] - lower[k]) / h - 1e-9).ceil().max(1.0) as usize).saturating_add(2 * margin)
+        });
+        Self::new(origin, h, cells, order)
+    }
+
+    /// Cells added on each side of the box by [`Self::covering`].
+    pub const COVER_MARGIN: usize = 2;
+
+    /// Cells per axis.
+    pub fn cells(&self) -> [usize; D] {
+        self.cells
+    }
+
     /// The spline order.
     pub fn order(&self) -> BSplineOrder {
         self.order
@@ -181,5 +211,30 @@ impl<const D: usize> Kernel<D> for BSplineKernel<D> {
             out.push(node as u32, value, gradient)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector2;
+
+    use super::*;
+
+    #[test]
+    fn covering_grid_reaches_past_the_box_by_its_margin() {
+        let (lower, upper) = (Vector2::new(-1.0, 0.5), Vector2::new(2.0, 1.7));
+        let h = 0.25;
+        let grid = BSplineKernel::covering(lower, upper, h, BSplineOrder::Quadratic).unwrap();
+        let margin = BSplineKernel::<2>::COVER_MARGIN as f64 * h;
+        let first = grid.node_position(0);
+        let last = grid.node_position(grid.node_count() - 1);
+        for k in 0..2 {
+            assert!((first[k] - (lower[k] - margin)).abs() < 1e-12);
+            // The far side: at least the margin beyond the box, less than a cell more.
+            assert!(last[k] >= upper[k] + margin - 1e-12 && last[k] < upper[k] + margin + h);
+        }
+        assert_eq!(grid.cells(), [12 + 4, 5 + 4]);
+        assert!(BSplineKernel::covering(lower, upper, 0.0, BSplineOrder::Cubic).is_none());
+        assert!(BSplineKernel::covering(lower, upper, f64::NAN, BSplineOrder::Cubic).is_none());
     }
 }

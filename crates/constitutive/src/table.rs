@@ -1,13 +1,14 @@
-//! The material table of a scene: several named materials in one simulation, chosen per
-//! particle by an id in the particle state.
+//! A material table: several materials in one simulation, chosen per particle by an id in
+//! the particle state.
 //!
-//! The engine is generic over one material type; a scene file picks models at run time,
-//! so this adapter dispatches with a `match`. Plasticity is a type parameter: a scene
+//! The engine is generic over one material type; a scene picks models at run time, so
+//! this adapter dispatches with a `match`. Plasticity is a type parameter: a scene
 //! without plastic materials runs `MaterialTable<NoPlasticity>`, whose state is only the
 //! id and whose plastic branch does not exist, so elastic scenes never pay for it.
 
 use nalgebra::SMatrix;
-use umls_constitutive::{
+
+use crate::{
     Constitutive, ConstitutiveError, DruckerPrager, ElastoPlastic, FixedCorotated, LinearElastic,
     NeoHookean, PlasticState, StVenantKirchhoff, VonMises, WeaklyCompressibleFluid,
 };
