@@ -1,5 +1,6 @@
 //! Built-in scene files with numbers replaced by hostile values: building the scene
-//! returns a setup or an error, never panics. (Counts large enough to exhaust memory are
+//! returns a setup or an error that starts with the file and names a key or a line,
+//! never panics (random combinations, and every number with every hostile value). (Counts large enough to exhaust memory are
 //! refused by explicit limits, tested in `scene_files.rs`; the largest count here is
 //! 1000 so that the cases stay fast.)
 
@@ -91,4 +92,42 @@ fn the_number_finder_sees_the_scene_numbers() {
         !found.iter().any(|n| n.contains("50")),
         "numbers inside strings are left alone"
     );
+}
+
+/// Every number of every built-in scene, replaced in turn by each hostile value: the
+/// scene builds, or the error starts with the file and names a key or a line.
+#[test]
+fn every_number_of_every_scene_with_hostile_values() {
+    let mut errors = 0;
+    let mut cases = 0;
+    for builtin in BUILTIN {
+        for (a, b) in numbers(builtin.toml) {
+            for value in ["-1", "0", "nan", "inf", "-inf", "1e300", "1e-300"] {
+                let mut text = builtin.toml.to_string();
+                text.replace_range(a..b, value);
+                cases += 1;
+                let result =
+                    Scene::parse(&text, "edited.toml", None).and_then(|scene| {
+                        match scene.spec.scene.dimension {
+                            1 => build::<1>(&scene, segments).map(drop),
+                            2 => build::<2>(&scene, triangles).map(drop),
+                            3 => build::<3>(&scene, tetrahedra).map(drop),
+                            _ => Ok(()),
+                        }
+                    });
+                if let Err(e) = result {
+                    errors += 1;
+                    let m = e.to_string();
+                    let context = &builtin.toml[a.saturating_sub(30)..b];
+                    assert!(m.starts_with("edited.toml"), "`{context}` → {value}: {m}");
+                    assert!(
+                        m.contains('`') || m.contains("line"),
+                        "`{context}` → {value}: no key or line in {m}"
+                    );
+                }
+            }
+        }
+    }
+    // The sweep must exercise the error paths, not only accept values.
+    assert!(errors * 3 > cases, "{errors} errors of {cases} cases");
 }
