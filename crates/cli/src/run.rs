@@ -13,7 +13,7 @@ use std::time::Instant;
 use nalgebra::SVector;
 use serde_json::json;
 use umls_engine::{
-    Apic, Boundary, Diagnostics, EngineError, Flip, Particles, Pic, Simulation, StepSettings,
+    Apic, Boundary, Diagnostics, EngineError, Flip, Particles, Simulation, StepSettings,
     TimeStepControl, TransferScheme, VelocityGradientAffine, Wall, WallKind,
 };
 use umls_io::csv::HistoryWriter;
@@ -249,12 +249,50 @@ fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
     kernel: K,
     table: MaterialTable<P>,
 ) -> Result<RunReport> {
+    // Two transfer types instead of four halve the simulations this crate compiles: PIC is
+    // FLIP with α = 0 (v = 0·(v + Δv) + 1·v_PIC, the same numbers), and the two affine
+    // schemes share one type.
     let t = &ctx.scene.spec.transfer;
     match t.kind {
-        TransferKind::Pic => start(ctx, kernel, table, Pic),
+        TransferKind::Pic => start(ctx, kernel, table, Flip { alpha: 0.0 }),
         TransferKind::Flip => start(ctx, kernel, table, Flip { alpha: t.alpha }),
-        TransferKind::Apic => start(ctx, kernel, table, Apic),
-        TransferKind::VelocityGradient => start(ctx, kernel, table, VelocityGradientAffine),
+        TransferKind::Apic => start(ctx, kernel, table, AffineTransfer::Apic),
+        TransferKind::VelocityGradient => {
+            start(ctx, kernel, table, AffineTransfer::VelocityGradient)
+        }
+    }
+}
+
+/// APIC or the velocity-gradient affine transfer, chosen at run time. Both carry C_p; the
+/// moments B_p and D_p are accumulated for both although only APIC reads them (a few
+/// flops per node, against a second copy of every simulation type in the binary).
+#[derive(Debug, Clone, Copy)]
+enum AffineTransfer {
+    Apic,
+    VelocityGradient,
+}
+
+impl TransferScheme for AffineTransfer {
+    const AFFINE: bool = true;
+    const USES_MOMENTS: bool = true;
+
+    fn name(&self) -> &'static str {
+        match self {
+            Self::Apic => Apic.name(),
+            Self::VelocityGradient => VelocityGradientAffine.name(),
+        }
+    }
+
+    fn affine<const D: usize>(
+        &self,
+        b: &nalgebra::SMatrix<f64, D, D>,
+        d: &nalgebra::SMatrix<f64, D, D>,
+        grad_v: &nalgebra::SMatrix<f64, D, D>,
+    ) -> nalgebra::SMatrix<f64, D, D> {
+        match self {
+            Self::Apic => Apic.affine(b, d, grad_v),
+            Self::VelocityGradient => VelocityGradientAffine.affine(b, d, grad_v),
+        }
     }
 }
 
@@ -406,28 +444,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     }
 
     let mut out = OutputDir::create(&ctx.options.out, ctx.encoding)?;
-    let axes = ["x", "y", "z"];
-    let mut header: Vec<String> = ["step", "time", "kinetic", "elastic", "potential", "total"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    header.extend((0..D).map(|k| format!("momentum_{}", axes[k])));
-    header.extend(
-        [
-            "mass",
-            "max_speed",
-            "courant",
-            "dt",
-            "wave_courant",
-            "dropped_mass",
-            "wall_corrections",
-            "mass_scaled_nodes",
-        ]
-        .map(String::from),
-    );
-    if setup.reference.is_some() {
-        header.push("velocity_error".into());
-    }
+    let header = history_header(D, setup.reference.is_some());
     let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut history = HistoryWriter::create(out.path("history.csv"), &header_refs)?;
 
@@ -441,26 +458,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
      -> Result<(f64, Diagnostics<D>, EnergyRecord)> {
         let d = sim.diagnostics()?;
         let (potential, total) = total_energy(&d);
-        let mut row = vec![
-            d.step as f64,
-            d.time,
-            d.kinetic,
-            d.elastic,
-            potential,
-            total,
-        ];
-        row.extend(d.momentum.iter());
-        row.extend([
-            d.mass,
-            d.max_speed,
-            d.courant,
-            d.dt,
-            d.wave_courant,
-            d.dropped_mass,
-            d.wall_corrections as f64,
-            d.mass_scaled_nodes as f64,
-        ]);
-        row.extend(error);
+        let row = history_row(&d, potential, total, error);
         history.row(&row)?;
         let record = EnergyRecord {
             time: d.time,
@@ -657,6 +655,65 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
             out: ctx.options.out.clone(),
         }),
     }
+}
+
+/// Columns of `history.csv`.
+fn history_header(dimension: usize, with_reference: bool) -> Vec<String> {
+    let mut header: Vec<String> = ["step", "time", "kinetic", "elastic", "potential", "total"]
+        .map(String::from)
+        .into();
+    header.extend(
+        ["x", "y", "z"][..dimension]
+            .iter()
+            .map(|a| format!("momentum_{a}")),
+    );
+    header.extend(
+        [
+            "mass",
+            "max_speed",
+            "courant",
+            "dt",
+            "wave_courant",
+            "dropped_mass",
+            "wall_corrections",
+            "mass_scaled_nodes",
+        ]
+        .map(String::from),
+    );
+    if with_reference {
+        header.push("velocity_error".into());
+    }
+    header
+}
+
+/// One row of `history.csv`, in the order of [`history_header`].
+fn history_row<const D: usize>(
+    d: &Diagnostics<D>,
+    potential: f64,
+    total: f64,
+    error: Option<f64>,
+) -> Vec<f64> {
+    let mut row = vec![
+        d.step as f64,
+        d.time,
+        d.kinetic,
+        d.elastic,
+        potential,
+        total,
+    ];
+    row.extend(d.momentum.iter());
+    row.extend([
+        d.mass,
+        d.max_speed,
+        d.courant,
+        d.dt,
+        d.wave_courant,
+        d.dropped_mass,
+        d.wall_corrections as f64,
+        d.mass_scaled_nodes as f64,
+    ]);
+    row.extend(error);
+    row
 }
 
 /// The fixed step (or the cap of the adaptive one) and the planned number of steps;

@@ -69,6 +69,32 @@ fn disks_file_runs_like_the_hand_written_scene() {
     );
 }
 
+/// The command line runs PIC as FLIP with α = 0 (one simulation type fewer to compile):
+/// the energies match the library's own PIC to round-off.
+#[test]
+fn pic_from_a_file_is_the_library_pic() {
+    let text = umls_cli::builtin::BUILTIN[0].toml;
+    let flip = "kind = \"flip\"\nalpha = 0.99";
+    assert!(text.contains(flip));
+    let scene = Scene::parse(&text.replacen(flip, "kind = \"pic\"", 1), "pic.toml", None).unwrap();
+    let report = run(&scene, &options("disks-pic", Some(0.05))).unwrap();
+    assert_eq!(report.summary["transfer"], "pic");
+    let reference = CollidingDisks::default();
+    let mesh = reference.shared_mesh().unwrap();
+    let mut sim = reference
+        .simulation(Umls2::new(mesh), umls_engine::Pic)
+        .unwrap();
+    for _ in 0..50 {
+        sim.step().unwrap();
+    }
+    let expected = sim.diagnostics().unwrap().total_energy();
+    let found = report.summary["metrics"]["final_energy"].as_f64().unwrap();
+    assert!(
+        (found - expected).abs() < 1e-12 * expected,
+        "{found} vs {expected}"
+    );
+}
+
 #[test]
 fn bar_file_matches_the_hand_written_scene_error() {
     let scene = Scene::load("vibrating-bar").unwrap();
