@@ -13,8 +13,8 @@ use std::time::Instant;
 use nalgebra::SVector;
 use serde_json::json;
 use umls_engine::{
-    Apic, Boundary, Diagnostics, EngineError, Flip, Particles, Simulation, StepSettings,
-    TimeStepControl, TransferScheme, VelocityGradientAffine, Wall, WallKind,
+    Apic, Boundary, Diagnostics, EngineError, Flip, Particles, Simulation, StageTimes,
+    StepSettings, TimeStepControl, TransferScheme, VelocityGradientAffine, Wall, WallKind,
 };
 use umls_io::csv::HistoryWriter;
 use umls_io::vtk::Encoding;
@@ -348,6 +348,7 @@ trait Run<const D: usize> {
     fn node_positions(&self) -> Vec<SVector<f64, D>>;
     fn node_count(&self) -> usize;
     fn last_dt(&self) -> f64;
+    fn stage_times(&self) -> StageTimes;
 }
 
 impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
@@ -408,6 +409,9 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
     }
     fn last_dt(&self) -> f64 {
         Simulation::last_dt(self)
+    }
+    fn stage_times(&self) -> StageTimes {
+        *Simulation::stage_times(self)
     }
 }
 
@@ -634,6 +638,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         },
         "error": failure.as_ref().map(|e| e.to_string()),
         "wall_time_s": wall,
+        "stage_seconds": stage_seconds(&sim.stage_times()),
         "particle_steps_per_second": if wall > 0.0 { (sim.positions().len() * taken) as f64 / wall } else { 0.0 },
         "metrics": metrics,
         "outputs": {
@@ -655,6 +660,30 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
             out: ctx.options.out.clone(),
         }),
     }
+}
+
+/// Seconds per stage of the step, and their share of the stepping time.
+fn stage_seconds(times: &StageTimes) -> serde_json::Value {
+    let total = times.total();
+    let mut map = serde_json::Map::new();
+    for (name, seconds) in times.stages() {
+        map.insert(name.into(), json!(seconds));
+    }
+    map.insert("total".into(), json!(total));
+    map.insert(
+        "fractions".into(),
+        json!(
+            times
+                .stages()
+                .iter()
+                .map(|(name, s)| (
+                    name.to_string(),
+                    json!(if total > 0.0 { s / total } else { 0.0 })
+                ))
+                .collect::<serde_json::Map<_, _>>()
+        ),
+    );
+    json!(map)
 }
 
 /// Columns of `history.csv`.

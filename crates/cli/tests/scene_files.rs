@@ -61,6 +61,19 @@ fn disks_file_runs_like_the_hand_written_scene() {
     let d = sim.diagnostics().unwrap();
     let s = &report.summary;
     assert_eq!(s["steps"], 50);
+    // Every stage is timed, inside the run's wall time, and the shares add up.
+    assert_eq!(sim.stage_times().steps, 50);
+    let stages = &s["stage_seconds"];
+    let total = stages["total"].as_f64().unwrap();
+    assert!(total > 0.0 && total <= s["wall_time_s"].as_f64().unwrap(), "{stages}");
+    let shares: f64 = stages["fractions"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_f64().unwrap())
+        .sum();
+    assert!((shares - 1.0).abs() < 1e-12, "{stages}");
+    assert!(stages["stencils"].as_f64().unwrap() > 0.0);
     let final_energy = s["metrics"]["final_energy"].as_f64().unwrap();
     assert!(
         (final_energy - d.total_energy()).abs() < 1e-12 * d.total_energy(),

@@ -53,6 +53,7 @@ mod seeding;
 mod settings;
 mod simulation;
 mod stencils;
+mod timing;
 mod transfer;
 
 pub use boundary::{Boundary, Wall, WallKind};
@@ -62,4 +63,5 @@ pub use particles::Particles;
 pub use seeding::{Inside, Region, lattice_samples};
 pub use settings::{Damping, StepSettings, TimeStepControl};
 pub use simulation::{BodyForce, Simulation};
+pub use timing::StageTimes;
 pub use transfer::{Apic, Flip, Pic, StressUpdate, TransferScheme, VelocityGradientAffine};

@@ -14,6 +14,7 @@ use crate::grid::Grid;
 use crate::particles::Particles;
 use crate::settings::{Damping, StepSettings, TimeStepControl};
 use crate::stencils::Stencils;
+use crate::timing::{Lap, StageTimes};
 use crate::transfer::{StressUpdate, TransferScheme};
 
 /// A body acceleration field b(x, t), added to gravity.
@@ -115,6 +116,7 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     stencils: Stencils<D>,
     blocks: Vec<GridBuffer<D>>,
     grid: Grid<D>,
+    times: StageTimes,
 }
 
 /// Checks a number setting.
@@ -229,6 +231,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             totals: Totals::default(),
             stencils: Stencils::default(),
             blocks: Vec::new(),
+            times: StageTimes::default(),
             grid,
         })
     }
@@ -246,6 +249,11 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     /// The time step of the last step (the configured one before the first step).
     pub fn last_dt(&self) -> f64 {
         self.dt
+    }
+
+    /// Wall time spent in each stage of [`Self::step`] so far.
+    pub fn stage_times(&self) -> &StageTimes {
+        &self.times
     }
 
     /// The last step's Δt, or before the first step the one it will take.
@@ -431,6 +439,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 wave_courant: dt / stable,
             });
         }
+        let mut clock = Lap::start();
         // 1. Stencils.
         self.stencils
             .compute(
@@ -443,8 +452,12 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 particle,
                 source,
             })?;
-        // 2. P2G.
-        self.particles_to_grid()?;
+        self.times.stencils += clock.lap();
+        // 2. Stresses, then P2G.
+        let stresses = self.stresses()?;
+        self.times.constitutive += clock.lap();
+        self.particles_to_grid(&stresses);
+        self.times.particles_to_grid += clock.lap();
         // 3. Grid update.
         let report = self.grid.update(
             dt,
@@ -469,13 +482,16 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 index: node,
             });
         }
+        self.times.grid_update += clock.lap();
         // 4. G2P and walls.
         let mut velocity_gradients = self.grid_to_particles(dt);
         if self.settings.stress_update == StressUpdate::Musl {
             velocity_gradients = self.musl_velocity_gradients();
         }
+        self.times.grid_to_particles += clock.lap();
         // 5. Deformation and stress update.
         let min_density = self.update_deformation(&velocity_gradients, dt)?;
+        self.times.constitutive += clock.lap();
         self.step += 1;
         self.time += dt;
         // 6. Failure detection.
@@ -483,14 +499,15 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         if self.step % self.settings.energy_check_interval == 0 {
             self.check_energy(step)?;
         }
+        self.times.checks += clock.lap();
+        self.times.steps += 1;
         Ok(())
     }
 
-    /// P2G: stresses in parallel, then the scatter in P2G_BLOCKS fixed particle blocks,
+    /// P2G: the scatter in P2G_BLOCKS fixed particle blocks,
     /// each into its own grid buffer, in parallel; buffers are summed per node in block
     /// order. The split does not depend on the thread count, so neither do the sums.
-    fn particles_to_grid(&mut self) -> Result<(), EngineError> {
-        let stresses = self.stresses()?;
+    fn particles_to_grid(&mut self, stresses: &[SMatrix<f64, D, D>]) {
         let p = &self.particles;
         let (stencils, kernel, time) = (&self.stencils, &self.kernel, self.time);
         let gravity = self.settings.gravity_at(time);
@@ -559,7 +576,6 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         .fold(SVector::zeros(), |acc, b| acc + b.force[node]);
                 },
             );
-        Ok(())
     }
 
     /// G2P: velocity, affine matrix, position, velocity gradient; then the walls. Returns
