@@ -65,7 +65,10 @@ fn disks_file_runs_like_the_hand_written_scene() {
     assert_eq!(sim.stage_times().steps, 50);
     let stages = &s["stage_seconds"];
     let total = stages["total"].as_f64().unwrap();
-    assert!(total > 0.0 && total <= s["wall_time_s"].as_f64().unwrap(), "{stages}");
+    assert!(
+        total > 0.0 && total <= s["wall_time_s"].as_f64().unwrap(),
+        "{stages}"
+    );
     let shares: f64 = stages["fractions"]
         .as_object()
         .unwrap()

@@ -74,6 +74,31 @@ pub struct NeighbourIndex {
     ambient: usize,
 }
 
+/// Runs `$body` with `$tree` bound to the k-d tree and `$q` to the first K coordinates of
+/// `$y` as the `[f64; K]` query that tree takes.
+macro_rules! with_tree {
+    ($tree_enum:expr, $tree:ident, $q:ident = $y:expr => $body:expr) => {
+        match $tree_enum {
+            Tree::D1($tree) => {
+                let $q: [f64; 1] = std::array::from_fn(|i| $y[i]);
+                $body
+            }
+            Tree::D2($tree) => {
+                let $q: [f64; 2] = std::array::from_fn(|i| $y[i]);
+                $body
+            }
+            Tree::D3($tree) => {
+                let $q: [f64; 3] = std::array::from_fn(|i| $y[i]);
+                $body
+            }
+            Tree::D4($tree) => {
+                let $q: [f64; 4] = std::array::from_fn(|i| $y[i]);
+                $body
+            }
+        }
+    };
+}
+
 macro_rules! build_tree {
     ($k:literal, $rows:expr) => {{
         let rows: Vec<[f64; $k]> = $rows
@@ -203,39 +228,19 @@ impl NeighbourIndex {
 
     /// Tree items within squared distance `r2` of `y` in the searched space.
     fn within_projected(&self, y: &[f64], r2: f64) -> Vec<usize> {
-        macro_rules! within {
-            ($t:expr, $k:literal) => {{
-                let q: [f64; $k] = std::array::from_fn(|i| y[i]);
-                $t.within_unsorted::<SquaredEuclidean>(&q, r2)
-                    .into_iter()
-                    .map(|n| n.item as usize)
-                    .collect()
-            }};
-        }
-        match &self.tree {
-            Tree::D1(t) => within!(t, 1),
-            Tree::D2(t) => within!(t, 2),
-            Tree::D3(t) => within!(t, 3),
-            Tree::D4(t) => within!(t, 4),
-        }
+        with_tree!(&self.tree, tree, q = y => tree
+            .within_unsorted::<SquaredEuclidean>(&q, r2)
+            .into_iter()
+            .map(|n| n.item as usize)
+            .collect())
     }
 
     fn nearest_projected(&self, y: &[f64], k: NonZero<usize>) -> Vec<usize> {
-        macro_rules! nearest {
-            ($t:expr, $k:literal) => {{
-                let q: [f64; $k] = std::array::from_fn(|i| y[i]);
-                $t.nearest_n::<SquaredEuclidean>(&q, k)
-                    .into_iter()
-                    .map(|n| n.item as usize)
-                    .collect()
-            }};
-        }
-        match &self.tree {
-            Tree::D1(t) => nearest!(t, 1),
-            Tree::D2(t) => nearest!(t, 2),
-            Tree::D3(t) => nearest!(t, 3),
-            Tree::D4(t) => nearest!(t, 4),
-        }
+        with_tree!(&self.tree, tree, q = y => tree
+            .nearest_n::<SquaredEuclidean>(&q, k)
+            .into_iter()
+            .map(|n| n.item as usize)
+            .collect())
     }
 
     /// The `k` samples nearest to `query` (exact), nearest first; ties by index.
