@@ -53,6 +53,7 @@ impl<const D: usize> GridBuffer<D> {
 }
 
 /// What G2P computes for one particle.
+#[derive(Debug, Clone, Copy)]
 struct ParticleUpdate<const D: usize> {
     velocity: SVector<f64, D>,
     /// Moved with the PIC velocity Σ N ṽ_i.
@@ -117,6 +118,11 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     blocks: Vec<GridBuffer<D>>,
     grid: Grid<D>,
     times: StageTimes,
+    // Per-particle buffers the step reuses, so a step allocates nothing once they have
+    // grown to the particle count.
+    stress_buffer: Vec<SMatrix<f64, D, D>>,
+    updates: Vec<ParticleUpdate<D>>,
+    velocity_gradients: Vec<SMatrix<f64, D, D>>,
 }
 
 /// Checks a number setting.
@@ -232,6 +238,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             stencils: Stencils::default(),
             blocks: Vec::new(),
             times: StageTimes::default(),
+            stress_buffer: Vec::new(),
+            updates: Vec::new(),
+            velocity_gradients: Vec::new(),
             grid,
         })
     }
@@ -316,6 +325,40 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     })
             })
             .collect()
+    }
+
+    /// Kirchhoff stresses into the reused buffer; among failures the lowest particle
+    /// index wins, so the report does not depend on the thread count.
+    fn compute_stresses(&mut self) -> Result<(), EngineError> {
+        let (material, step, p) = (&self.material, self.step, &self.particles);
+        self.stress_buffer.resize(p.len(), SMatrix::zeros());
+        self.stress_buffer
+            .par_iter_mut()
+            .enumerate()
+            .map(|(i, stress)| -> Result<(), (usize, EngineError)> {
+                *stress = material
+                    .kirchhoff_stress(&p.deformation[i], &p.state[i])
+                    .map_err(|source| {
+                        (
+                            i,
+                            EngineError::Material {
+                                step,
+                                particle: i,
+                                source,
+                            },
+                        )
+                    })?;
+                Ok(())
+            })
+            .reduce(
+                || Ok(()),
+                |a, b| match (a, b) {
+                    (Ok(()), Ok(())) => Ok(()),
+                    (Err(e), Ok(())) | (Ok(()), Err(e)) => Err(e),
+                    (Err(e1), Err(e2)) => Err(if e1.0 <= e2.0 { e1 } else { e2 }),
+                },
+            )
+            .map_err(|(_, e)| e)
     }
 
     /// Σ V⁰ ψ(F) over the particles (in parallel, summed in particle order).
@@ -454,9 +497,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             })?;
         self.times.stencils += clock.lap();
         // 2. Stresses, then P2G.
-        let stresses = self.stresses()?;
+        self.compute_stresses()?;
         self.times.constitutive += clock.lap();
-        self.particles_to_grid(&stresses);
+        self.particles_to_grid();
         self.times.particles_to_grid += clock.lap();
         // 3. Grid update.
         let report = self.grid.update(
@@ -484,13 +527,16 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         }
         self.times.grid_update += clock.lap();
         // 4. G2P and walls.
-        let mut velocity_gradients = self.grid_to_particles(dt);
+        self.grid_to_particles(dt);
         if self.settings.stress_update == StressUpdate::Musl {
-            velocity_gradients = self.musl_velocity_gradients();
+            self.velocity_gradients = self.musl_velocity_gradients();
         }
         self.times.grid_to_particles += clock.lap();
         // 5. Deformation and stress update.
-        let min_density = self.update_deformation(&velocity_gradients, dt)?;
+        let gradients = std::mem::take(&mut self.velocity_gradients);
+        let deformed = self.update_deformation(&gradients, dt);
+        self.velocity_gradients = gradients;
+        let min_density = deformed?;
         self.times.constitutive += clock.lap();
         self.step += 1;
         self.time += dt;
@@ -507,7 +553,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     /// P2G: the scatter in P2G_BLOCKS fixed particle blocks,
     /// each into its own grid buffer, in parallel; buffers are summed per node in block
     /// order. The split does not depend on the thread count, so neither do the sums.
-    fn particles_to_grid(&mut self, stresses: &[SMatrix<f64, D, D>]) {
+    fn particles_to_grid(&mut self) {
+        let stresses = &self.stress_buffer;
         let p = &self.particles;
         let (stencils, kernel, time) = (&self.stencils, &self.kernel, self.time);
         let gravity = self.settings.gravity_at(time);
@@ -578,14 +625,15 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             );
     }
 
-    /// G2P: velocity, affine matrix, position, velocity gradient; then the walls. Returns
-    /// the velocity gradients.
-    fn grid_to_particles(&mut self, dt: f64) -> Vec<SMatrix<f64, D, D>> {
+    /// G2P: velocity, affine matrix, position, velocity gradient; then the walls. The
+    /// velocity gradients go to `self.velocity_gradients`.
+    fn grid_to_particles(&mut self, dt: f64) {
         let (kernel, transfer, stencils) = (&self.kernel, self.transfer, &self.stencils);
         let (old_v, new_v) = (&self.grid.velocity, &self.grid.new_velocity);
         let positions = &self.particles.position;
         let velocities = &self.particles.velocity;
-        let updates: Vec<ParticleUpdate<D>> = (0..self.particles.len())
+        let mut updates = std::mem::take(&mut self.updates);
+        (0..self.particles.len())
             .into_par_iter()
             .with_min_len(crate::stencils::CHUNK)
             .map(|i| {
@@ -622,8 +670,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     velocity_gradient: grad_v,
                 }
             })
-            .collect();
-        let mut velocity_gradients = Vec::with_capacity(updates.len());
+            .collect_into_vec(&mut updates);
+        let mut velocity_gradients = std::mem::take(&mut self.velocity_gradients);
+        velocity_gradients.clear();
         let p = &mut self.particles;
         let gravity = self.settings.gravity_at(self.time);
         let body_force = self.body_force.as_ref();
@@ -637,7 +686,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .boundary
             .has_node_conditions()
             .then(|| self.boundary.node_marks(self.grid.mass.len()));
-        for (i, update) in updates.into_iter().enumerate() {
+        for (i, update) in updates.iter().enumerate() {
             let acceleration =
                 body_force.map_or(gravity, |b| gravity + b(&p.position[i], self.time));
             power += p.mass[i] * acceleration.dot(&(p.velocity[i] + update.velocity)) * 0.5;
@@ -664,7 +713,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         }
         self.totals.external_work += power * dt;
         self.totals.longest_move = longest;
-        velocity_gradients
+        self.updates = updates;
+        self.velocity_gradients = velocity_gradients;
     }
 
     /// F ← (I + Δt ∇v) F and the return map; the smallest density m / (V⁰ det F).
