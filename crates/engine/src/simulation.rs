@@ -82,9 +82,10 @@ fn limited_affine<const D: usize, K: Kernel<D>>(
         return if moment == 0.0 { SMatrix::zeros() } else { *c };
     }
     let mut d = SMatrix::<f64, D, D>::zeros();
-    for e in stencils.range(i) {
-        let r = kernel.node_position(stencils.nodes[e] as usize) - x;
-        d += r * r.transpose() * stencils.values[e];
+    let st = stencils.of(i);
+    for e in 0..st.len() {
+        let r = kernel.node_position(st.nodes[e] as usize) - x;
+        d += r * r.transpose() * st.values[e];
     }
     let now = (c * d * c.transpose()).trace();
     if now > moment * (1.0 + 1e-9) {
@@ -585,10 +586,11 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     let stress_volume = stress * volume;
                     let acceleration =
                         gravity + body_force.map_or(SVector::zeros(), |b| b(&x, time));
-                    for e in stencils.range(i) {
-                        let node = stencils.nodes[e] as usize;
-                        let n = stencils.values[e];
-                        let gradient = stencils.gradients[e];
+                    let st = stencils.of(i);
+                    for e in 0..st.len() {
+                        let node = st.nodes[e] as usize;
+                        let n = st.values[e];
+                        let gradient = st.gradients[e];
                         buffer.mass[node] += n * m;
                         buffer.abs_mass[node] += n.abs() * m;
                         buffer.stiffness[node] += volume * gradient.norm_squared();
@@ -643,12 +645,13 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 let mut grad_v = SMatrix::<f64, D, D>::zeros();
                 let mut b = SMatrix::<f64, D, D>::zeros();
                 let mut d = SMatrix::<f64, D, D>::zeros();
-                for e in stencils.range(i) {
-                    let node = stencils.nodes[e] as usize;
-                    let n = stencils.values[e];
+                let st = stencils.of(i);
+                for e in 0..st.len() {
+                    let node = st.nodes[e] as usize;
+                    let n = st.values[e];
                     pic += new_v[node] * n;
                     flip += (new_v[node] - old_v[node]) * n;
-                    grad_v += new_v[node] * stencils.gradients[e].transpose();
+                    grad_v += new_v[node] * st.gradients[e].transpose();
                     if T::AFFINE {
                         let r = kernel.node_position(node) - x;
                         d += r * r.transpose() * n;
@@ -851,9 +854,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         g.momentum.iter_mut().for_each(|m| *m = SVector::zeros());
         let p = &self.particles;
         for i in 0..p.len() {
-            for e in self.stencils.range(i) {
-                let node = self.stencils.nodes[e] as usize;
-                g.momentum[node] += p.velocity[i] * (self.stencils.values[e] * p.mass[i]);
+            let st = self.stencils.of(i);
+            for e in 0..st.len() {
+                let node = st.nodes[e] as usize;
+                g.momentum[node] += p.velocity[i] * (st.values[e] * p.mass[i]);
             }
         }
         let fraction = self.settings.cancellation_fraction;
@@ -869,10 +873,12 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         (0..p.len())
             .into_par_iter()
             .map(|i| {
-                stencils
-                    .range(i)
-                    .fold(SMatrix::<f64, D, D>::zeros(), |acc, e| {
-                        acc + v[stencils.nodes[e] as usize] * stencils.gradients[e].transpose()
+                let st = stencils.of(i);
+                st.nodes
+                    .iter()
+                    .zip(st.gradients)
+                    .fold(SMatrix::<f64, D, D>::zeros(), |acc, (&node, gradient)| {
+                        acc + v[node as usize] * gradient.transpose()
                     })
             })
             .collect()

@@ -1,5 +1,5 @@
-//! Per-step stencils of all particles in compact arrays, computed in parallel with a
-//! result that does not depend on the number of threads.
+//! Per-step stencils of all particles, computed in parallel with a result that does not
+//! depend on the number of threads, into buffers that are reused from step to step.
 
 use nalgebra::SVector;
 use rayon::prelude::*;
@@ -9,63 +9,95 @@ use umls_transfer::{Kernel, KernelError, Stencil};
 /// result, is the same for any number of threads.
 pub(crate) const CHUNK: usize = 512;
 
-/// Stencil of particle p: entries `offsets[p]..offsets[p + 1]` of the flat arrays.
+/// The stencils of one chunk of [`CHUNK`] particles: particle k of the chunk owns entries
+/// `offsets[k]..offsets[k + 1]`. Each chunk keeps its vectors between steps, so once they
+/// have grown a step allocates nothing, and no serial pass copies chunks into one array.
+#[derive(Debug, Clone, Default)]
+struct ChunkStencils<const D: usize> {
+    offsets: Vec<usize>,
+    nodes: Vec<u32>,
+    values: Vec<f64>,
+    gradients: Vec<SVector<f64, D>>,
+}
+
+/// One particle's stencil: node indices, shape-function values and gradients.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ParticleStencil<'a, const D: usize> {
+    pub nodes: &'a [u32],
+    pub values: &'a [f64],
+    pub gradients: &'a [SVector<f64, D>],
+}
+
+impl<const D: usize> ParticleStencil<'_, D> {
+    /// Number of nodes.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+}
+
+/// The stencils of all particles, by chunk.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Stencils<const D: usize> {
-    pub offsets: Vec<usize>,
-    pub nodes: Vec<u32>,
-    pub values: Vec<f64>,
-    pub gradients: Vec<SVector<f64, D>>,
+    chunks: Vec<ChunkStencils<D>>,
 }
 
 impl<const D: usize> Stencils<D> {
+    /// The stencil of particle `p`.
     #[inline]
-    pub fn range(&self, p: usize) -> std::ops::Range<usize> {
-        self.offsets[p]..self.offsets[p + 1]
+    pub fn of(&self, p: usize) -> ParticleStencil<'_, D> {
+        let chunk = &self.chunks[p / CHUNK];
+        let k = p % CHUNK;
+        let range = chunk.offsets[k]..chunk.offsets[k + 1];
+        ParticleStencil {
+            nodes: &chunk.nodes[range.clone()],
+            values: &chunk.values[range.clone()],
+            gradients: &chunk.gradients[range],
+        }
     }
 
-    /// Evaluates every particle's stencil (updating its location cache).
+    /// Evaluates every particle's stencil (updating its location cache). Among failures
+    /// the lowest particle index is reported, whatever the thread count.
     pub fn compute<K: Kernel<D>>(
         &mut self,
         kernel: &K,
         positions: &[SVector<f64, D>],
         caches: &mut [K::Cache],
     ) -> Result<(), (usize, KernelError)> {
-        let chunks: Vec<Result<Stencils<D>, (usize, KernelError)>> = positions
-            .par_chunks(CHUNK)
+        self.chunks
+            .resize_with(positions.len().div_ceil(CHUNK), ChunkStencils::default);
+        self.chunks
+            .par_iter_mut()
+            .zip(positions.par_chunks(CHUNK))
             .zip(caches.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(c, (xs, cs))| {
-                let mut local = Stencils {
-                    offsets: Vec::with_capacity(xs.len()),
-                    ..Default::default()
-                };
-                let mut st = Stencil::new();
-                for (i, (x, cache)) in xs.iter().zip(cs.iter_mut()).enumerate() {
-                    kernel
-                        .stencil(x, cache, &mut st)
-                        .map_err(|e| (c * CHUNK + i, e))?;
+            .map(
+                |(c, ((local, xs), cs))| -> Result<(), (usize, KernelError)> {
+                    local.offsets.clear();
+                    local.nodes.clear();
+                    local.values.clear();
+                    local.gradients.clear();
+                    let mut st = Stencil::new();
+                    for (i, (x, cache)) in xs.iter().zip(cs.iter_mut()).enumerate() {
+                        kernel
+                            .stencil(x, cache, &mut st)
+                            .map_err(|e| (c * CHUNK + i, e))?;
+                        local.offsets.push(local.nodes.len());
+                        local.nodes.extend_from_slice(st.nodes());
+                        local.values.extend_from_slice(st.values());
+                        local.gradients.extend_from_slice(st.gradients());
+                    }
                     local.offsets.push(local.nodes.len());
-                    local.nodes.extend_from_slice(st.nodes());
-                    local.values.extend_from_slice(st.values());
-                    local.gradients.extend_from_slice(st.gradients());
-                }
-                Ok(local)
-            })
-            .collect();
-        self.offsets.clear();
-        self.nodes.clear();
-        self.values.clear();
-        self.gradients.clear();
-        for chunk in chunks {
-            let chunk = chunk?;
-            let base = self.nodes.len();
-            self.offsets.extend(chunk.offsets.iter().map(|o| o + base));
-            self.nodes.extend_from_slice(&chunk.nodes);
-            self.values.extend_from_slice(&chunk.values);
-            self.gradients.extend_from_slice(&chunk.gradients);
-        }
-        self.offsets.push(self.nodes.len());
-        Ok(())
+                    Ok(())
+                },
+            )
+            .reduce(
+                || Ok(()),
+                |a, b| match (a, b) {
+                    (Ok(()), Ok(())) => Ok(()),
+                    (Err(e), Ok(())) | (Ok(()), Err(e)) => Err(e),
+                    (Err(e1), Err(e2)) => Err(if e1.0 <= e2.0 { e1 } else { e2 }),
+                },
+            )
     }
 }
