@@ -48,6 +48,7 @@ mod diagnostics;
 mod error;
 pub mod geostatic;
 mod grid;
+mod parallel;
 mod particles;
 mod seeding;
 mod settings;

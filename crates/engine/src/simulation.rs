@@ -11,6 +11,7 @@ use crate::diagnostics::{Diagnostics, Totals};
 use crate::error::EngineError;
 use crate::geostatic;
 use crate::grid::Grid;
+use crate::parallel::lowest_failure;
 use crate::particles::Particles;
 use crate::settings::{Damping, StepSettings, TimeStepControl};
 use crate::stencils::Stencils;
@@ -351,14 +352,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     })?;
                 Ok(())
             })
-            .reduce(
-                || Ok(()),
-                |a, b| match (a, b) {
-                    (Ok(()), Ok(())) => Ok(()),
-                    (Err(e), Ok(())) | (Ok(()), Err(e)) => Err(e),
-                    (Err(e1), Err(e2)) => Err(if e1.0 <= e2.0 { e1 } else { e2 }),
-                },
-            )
+            .reduce(|| Ok(()), |a, b| lowest_failure(a, b, |(), ()| ()))
             .map_err(|(_, e)| e)
     }
 
@@ -765,14 +759,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             })
             // Among failures the lowest particle index wins, so the report does not
             // depend on the thread count.
-            .reduce(
-                || Ok(f64::INFINITY),
-                |a, b| match (a, b) {
-                    (Ok(x), Ok(y)) => Ok(x.min(y)),
-                    (Err(e), Ok(_)) | (Ok(_), Err(e)) => Err(e),
-                    (Err(e1), Err(e2)) => Err(if e1.0 <= e2.0 { e1 } else { e2 }),
-                },
-            )
+            .reduce(|| Ok(f64::INFINITY), |a, b| lowest_failure(a, b, f64::min))
             .map_err(|(_, e)| e)
     }
 

@@ -5,6 +5,8 @@ use nalgebra::SVector;
 use rayon::prelude::*;
 use umls_transfer::{Kernel, KernelError, Stencil};
 
+use crate::parallel::lowest_failure;
+
 /// Particles per parallel work item; fixed so that the work split, and hence every
 /// result, is the same for any number of threads.
 pub(crate) const CHUNK: usize = 512;
@@ -91,13 +93,6 @@ impl<const D: usize> Stencils<D> {
                     Ok(())
                 },
             )
-            .reduce(
-                || Ok(()),
-                |a, b| match (a, b) {
-                    (Ok(()), Ok(())) => Ok(()),
-                    (Err(e), Ok(())) | (Ok(()), Err(e)) => Err(e),
-                    (Err(e1), Err(e2)) => Err(if e1.0 <= e2.0 { e1 } else { e2 }),
-                },
-            )
+            .reduce(|| Ok(()), |a, b| lowest_failure(a, b, |(), ()| ()))
     }
 }
