@@ -7,41 +7,16 @@
 //! - `offset`: projection of queries 0.05 off S², N = 8k/32k/128k, with observed orders.
 //!
 //! `cargo run --release -p umls-manifold --example robustness_table [noise|torus|offset]`
-use std::f64::consts::{PI, TAU};
 use std::time::Instant;
+
 use umls_manifold::{Bandwidth, ManifoldMls, PointCloud, Settings};
 
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn normal(&mut self) -> f64 {
-        let (a, b) = (self.next().max(1e-300), self.next());
-        (-2.0 * a.ln()).sqrt() * (TAU * b).cos()
-    }
-}
-fn fib(count: usize) -> Vec<[f64; 3]> {
-    let golden = PI * (3.0 - 5f64.sqrt());
-    (0..count)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f64 + 0.5) / count as f64;
-            let r = (1.0 - z * z).sqrt();
-            [
-                r * (golden * i as f64).cos(),
-                r * (golden * i as f64).sin(),
-                z,
-            ]
-        })
-        .collect()
-}
-fn f(p: &[f64]) -> f64 {
-    (2.0 * p[0]).sin() + p[1] * p[2]
-}
+// The samplings and test functions of the crate's tests, so the tables and the tests
+// measure the same cases.
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use common::{Torus, fibonacci_sphere as fib, noisy_sphere, sphere_function as f};
 
 fn main() {
     let arg = std::env::args().nth(1).unwrap_or_default();
@@ -55,19 +30,9 @@ fn main() {
         let mut total = 0;
         for n in [4000usize, 16000, 64000] {
             for s in [0.01, 0.02, 0.03, 0.05] {
-                let mut rng = Lcg(n as u64 + (s * 1000.0) as u64);
-                let pts = fib(n);
-                let coords: Vec<f64> = pts
-                    .iter()
-                    .flat_map(|p| p.map(|x| x + s * rng.normal()))
-                    .collect();
-                let vals: Vec<f64> = pts.iter().map(|p| f(p) + s * rng.normal()).collect();
+                let cloud = noisy_sphere(n, s, n as u64 + (s * 1000.0) as u64);
                 for m in 1..=3 {
-                    let mls = ManifoldMls::new(
-                        PointCloud::new(3, coords.clone(), 1, vals.clone()).unwrap(),
-                        Settings::new(2, m),
-                    )
-                    .unwrap();
+                    let mls = ManifoldMls::new(cloud.clone(), Settings::new(2, m)).unwrap();
                     let mut fails = 0;
                     let mut err: f64 = 0.0;
                     let mut its = 0usize;
@@ -99,24 +64,7 @@ fn main() {
     }
     if arg.is_empty() || arg == "torus" {
         // Flat torus (cos u, sin u, cos v, sin v) isometrically in R⁶, v 11× coarser.
-        let mut rng = Lcg(9);
-        let mut basis: Vec<Vec<f64>> = Vec::new();
-        while basis.len() < 4 {
-            let mut v: Vec<f64> = (0..6).map(|_| rng.normal()).collect();
-            for c in &basis {
-                let d: f64 = v.iter().zip(c).map(|(a, b)| a * b).sum();
-                v.iter_mut().zip(c).for_each(|(a, b)| *a -= d * b);
-            }
-            let nr = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            basis.push(v.into_iter().map(|x| x / nr).collect());
-        }
-        let embed = |u: f64, v: f64| -> Vec<f64> {
-            let p = [u.cos(), u.sin(), v.cos(), v.sin()];
-            (0..6)
-                .map(|j| (0..4).map(|k| basis[k][j] * p[k]).sum())
-                .collect()
-        };
-        let g = |u: f64, v: f64| u.sin() * v.cos();
+        let torus = Torus::new();
         let (ku, kv): (usize, usize) = std::env::var("TORUS")
             .ok()
             .map(|s| {
@@ -124,35 +72,21 @@ fn main() {
                 (v[0], v[1])
             })
             .unwrap_or((440, 40));
-        let mut coords = Vec::new();
-        let mut vals = Vec::new();
-        for i in 0..ku {
-            for j in 0..kv {
-                let (u, v) = (TAU * i as f64 / ku as f64, TAU * j as f64 / kv as f64);
-                coords.extend(embed(u, v));
-                vals.push(g(u, v));
-            }
-        }
+        let cloud = torus.cloud(ku, kv);
         for factor in [3.0, 10.0, 20.0, 30.0] {
             for m in [1usize, 2] {
                 let settings = Settings {
                     bandwidth: Bandwidth::Neighbours { factor, scale: 2.0 },
                     ..Settings::new(2, m)
                 };
-                let mls = ManifoldMls::new(
-                    PointCloud::new(6, coords.clone(), 1, vals.clone()).unwrap(),
-                    settings,
-                )
-                .unwrap();
+                let mls = ManifoldMls::new(cloud.clone(), settings).unwrap();
                 let mut fails = 0;
                 let mut errs = Vec::new();
                 let mut conds: Vec<f64> = Vec::new();
-                let mut qrng = Lcg(77);
-                for _ in 0..200 {
-                    let (u, v) = (TAU * qrng.next(), TAU * qrng.next());
-                    match mls.evaluate(&embed(u, v)) {
+                for (u, v) in torus.queries(200) {
+                    match mls.evaluate(&torus.point(u, v)) {
                         Ok(e) => {
-                            let er = (e.value[0] - g(u, v)).abs();
+                            let er = (e.value[0] - Torus::value(u, v)).abs();
                             conds.push(e.quality.condition);
                             errs.push(er)
                         }

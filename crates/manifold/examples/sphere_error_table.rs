@@ -4,28 +4,13 @@
 //!
 //! `cargo run --release -p umls-manifold --example sphere_error_table`
 
-use std::f64::consts::PI;
-
 use umls_manifold::{ManifoldError, ManifoldMls, PointCloud, Settings};
 
-fn fibonacci_sphere(count: usize) -> Vec<[f64; 3]> {
-    let golden = PI * (3.0 - 5f64.sqrt());
-    (0..count)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f64 + 0.5) / count as f64;
-            let r = (1.0 - z * z).sqrt();
-            [
-                r * (golden * i as f64).cos(),
-                r * (golden * i as f64).sin(),
-                z,
-            ]
-        })
-        .collect()
-}
+// The sampling and test function of the crate's convergence test.
+#[path = "../tests/common/mod.rs"]
+mod common;
 
-fn f(p: &[f64]) -> f64 {
-    (2.0 * p[0]).sin() + p[1] * p[2]
-}
+use common::{fibonacci_sphere, sphere_function as f};
 
 fn main() -> Result<(), ManifoldError> {
     let levels = [500usize, 2000, 8000, 32000];

@@ -271,13 +271,18 @@ impl ChartProblem<'_> {
             .extend(self.frame.query.iter().map(|x| x / self.sigma));
         let mut history = 0usize;
         let mut previous_residual = f64::INFINITY;
-        let mut step = f64::INFINITY;
         let mut result = Err(ManifoldError::NotConverged {
             iterations: self.max_iterations,
-            step,
+            step: f64::INFINITY,
         });
         for iteration in 1..=self.max_iterations {
-            step = self.step(&z, &mut g, s)?;
+            let step = match self.step(&z, &mut g, s) {
+                Ok(step) => step,
+                Err(error) => {
+                    result = Err(error);
+                    break;
+                }
+            };
             if step < self.tolerance {
                 chart.q.clear();
                 chart.q.extend(g[..dim].iter().map(|x| x * self.sigma));
@@ -286,6 +291,9 @@ impl ChartProblem<'_> {
                 chart.iterations = iteration;
                 result = Ok(());
                 break;
+            }
+            if let Err(ManifoldError::NotConverged { step: last, .. }) = &mut result {
+                *last = step;
             }
             s.f.clear();
             s.f.extend(g.iter().zip(&z).map(|(g, z)| g - z));
@@ -313,17 +321,17 @@ impl ChartProblem<'_> {
             s.g_prev.clone_from(&g);
             previous_residual = residual;
             z.clone_from(&g);
-            if history > 0 && len > history && self.mix(history, len, &mut z, s) {
-                let (z_q, z_u) = z.split_at_mut(dim);
-                reproject(z_q, z_u, &s.scaled_query, d);
-            } else {
-                z.clone_from(&g);
+            if history > 0 && len > history {
+                if self.mix(history, len, &mut z, s) {
+                    let (z_q, z_u) = z.split_at_mut(dim);
+                    reproject(z_q, z_u, &s.scaled_query, d);
+                } else {
+                    // A failed mix may have changed z: fall back to the plain step.
+                    z.clone_from(&g);
+                }
             }
-            result = Err(ManifoldError::NotConverged {
-                iterations: self.max_iterations,
-                step,
-            });
         }
+        // The buffers go back to the workspace on every path, failures included.
         s.z = z;
         s.g = g;
         result

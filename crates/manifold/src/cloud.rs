@@ -134,7 +134,6 @@ impl PointCloud {
     /// must not count as a separate neighbour when the bandwidth is chosen from the
     /// K*-th neighbour distance, or replicated data would shrink σ to zero.
     pub(crate) fn distinct(&self) -> Option<Distinct> {
-        let n = self.ambient;
         let key = |i: usize| self.point(i).iter().map(|x| x + 0.0);
         let mut order: Vec<usize> = (0..self.len()).collect();
         order.sort_unstable_by(|&a, &b| {
@@ -172,7 +171,6 @@ impl PointCloud {
             start = end;
         }
         representatives.sort_unstable();
-        debug_assert!(n > 0);
         Some(Distinct {
             representatives,
             mass,

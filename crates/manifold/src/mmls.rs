@@ -426,7 +426,7 @@ impl ManifoldMls {
             },
             quality: FitQuality {
                 condition: fit.condition,
-                neighbours: fit.neighbours,
+                neighbours: fit.rows,
                 effective_neighbours: fit.effective,
                 iterations: *iterations,
                 widening: 1.0,

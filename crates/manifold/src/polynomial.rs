@@ -127,12 +127,11 @@ pub(crate) struct FitScratch {
 /// What a fit in the chart produced.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct FitSummary {
-    /// Rows of the solution (leading dimension of `FitScratch::solution`).
+    /// Rows of the solution (leading dimension of `FitScratch::solution`): the
+    /// neighbours with positive weight.
     pub rows: usize,
     /// Condition number of the column-equilibrated weighted design.
     pub condition: f64,
-    /// Neighbours with positive weight.
-    pub neighbours: usize,
     /// Kish's effective sample size (Σw)² / Σw².
     pub effective: f64,
 }
@@ -215,7 +214,6 @@ pub(crate) fn fit_values_and_offsets<'v>(
     Ok(FitSummary {
         rows,
         condition: conditioning.condition,
-        neighbours: rows,
         effective: sum * sum / sum2,
     })
 }

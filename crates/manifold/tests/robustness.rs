@@ -3,32 +3,10 @@
 
 mod common;
 
-use std::f64::consts::TAU;
-
 use umls_manifold::nalgebra::DMatrix;
 use umls_manifold::{
     Bandwidth, ManifoldError, ManifoldMls, NeighbourIndex, PointCloud, SearchStrategy, Settings,
 };
-
-/// Fibonacci samples of S² with Gaussian noise of standard deviation `s` on every
-/// coordinate and on the values of f = sin 2x + yz.
-fn noisy_sphere(count: usize, s: f64, seed: u64) -> PointCloud {
-    let mut rng = common::Lcg(seed);
-    let mut gauss = move || {
-        let (a, b) = (rng.next().max(1e-300), rng.next());
-        (-2.0 * a.ln()).sqrt() * (TAU * b).cos()
-    };
-    let pts = common::fibonacci_sphere(count);
-    let coords: Vec<f64> = pts
-        .iter()
-        .flat_map(|p| p.map(|x| x + s * gauss()))
-        .collect();
-    let values: Vec<f64> = pts
-        .iter()
-        .map(|p| common::sphere_function(p) + s * gauss())
-        .collect();
-    PointCloud::new(3, coords, 1, values).unwrap()
-}
 
 /// Query points on S², rotated off the sample lattice.
 fn sphere_queries(count: usize) -> Vec<[f64; 3]> {
@@ -45,7 +23,7 @@ fn noisy_sphere_never_fails_with_default_settings() {
     let queries = sphere_queries(100);
     for count in [4000usize, 16000, 64000] {
         for s in [0.01, 0.02, 0.03, 0.05] {
-            let cloud = noisy_sphere(count, s, count as u64 + (s * 1e3) as u64);
+            let cloud = common::noisy_sphere(count, s, count as u64 + (s * 1e3) as u64);
             for degree in 1..=3 {
                 let mls = ManifoldMls::new(cloud.clone(), Settings::new(2, degree)).unwrap();
                 let mut worst: f64 = 0.0;
@@ -64,63 +42,16 @@ fn noisy_sphere_never_fails_with_default_settings() {
     }
 }
 
-/// The flat torus (cos u, sin u, cos v, sin v) isometrically in R⁶, sampled on a
-/// `ku × kv` grid, with f = sin u cos v.
-struct Torus {
-    basis: Vec<Vec<f64>>,
-}
-
-impl Torus {
-    fn new() -> Self {
-        let mut rng = common::Lcg(9);
-        let mut basis: Vec<Vec<f64>> = Vec::new();
-        while basis.len() < 4 {
-            let mut v: Vec<f64> = (0..6).map(|_| rng.normal()).collect();
-            for c in &basis {
-                let d: f64 = v.iter().zip(c).map(|(a, b)| a * b).sum();
-                v.iter_mut().zip(c).for_each(|(a, b)| *a -= d * b);
-            }
-            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            basis.push(v.into_iter().map(|x| x / norm).collect());
-        }
-        Self { basis }
-    }
-
-    fn point(&self, u: f64, v: f64) -> Vec<f64> {
-        let p = [u.cos(), u.sin(), v.cos(), v.sin()];
-        (0..6)
-            .map(|j| (0..4).map(|k| self.basis[k][j] * p[k]).sum())
-            .collect()
-    }
-
-    fn value(u: f64, v: f64) -> f64 {
-        u.sin() * v.cos()
-    }
-
-    fn cloud(&self, ku: usize, kv: usize) -> PointCloud {
-        let mut coords = Vec::new();
-        let mut values = Vec::new();
-        for i in 0..ku {
-            for j in 0..kv {
-                let (u, v) = (TAU * i as f64 / ku as f64, TAU * j as f64 / kv as f64);
-                coords.extend(self.point(u, v));
-                values.push(Self::value(u, v));
-            }
-        }
-        PointCloud::new(6, coords, 1, values).unwrap()
-    }
-
-    /// (error, result) at 200 random parameter pairs.
-    fn errors(&self, mls: &ManifoldMls) -> Vec<Result<f64, ManifoldError>> {
-        let mut rng = common::Lcg(77);
-        (0..200)
-            .map(|_| {
-                let (u, v) = (TAU * rng.next(), TAU * rng.next());
-                mls.evaluate(&self.point(u, v))
-                    .map(|e| (e.value[0] - Self::value(u, v)).abs())
-            })
-            .collect()
-    }
+/// (error, result) at the torus's 200 random query points.
+fn torus_errors(torus: &common::Torus, mls: &ManifoldMls) -> Vec<Result<f64, ManifoldError>> {
+    torus
+        .queries(200)
+        .into_iter()
+        .map(|(u, v)| {
+            mls.evaluate(&torus.point(u, v))
+                .map(|e| (e.value[0] - common::Torus::value(u, v)).abs())
+        })
+        .collect()
 }
 
 /// Sampled 11× coarser in v than in u, the K* nearest samples lie nearly on one line and
@@ -128,11 +59,11 @@ impl Torus {
 /// number of 10⁴ that passed the old rank check.
 #[test]
 fn anisotropic_torus_is_accurate_or_reported() {
-    let torus = Torus::new();
+    let torus = common::Torus::new();
     let cloud = torus.cloud(440, 40);
     let with = |settings: Settings| ManifoldMls::new(cloud.clone(), settings).unwrap();
     // Defaults: the bandwidth widens until the fit is well-conditioned.
-    let errors = torus.errors(&with(Settings::new(2, 2)));
+    let errors = torus_errors(&torus, &with(Settings::new(2, 2)));
     let worst = errors
         .iter()
         .map(|e| *e.as_ref().unwrap())
@@ -140,10 +71,13 @@ fn anisotropic_torus_is_accurate_or_reported() {
     assert!(worst < 1e-3, "default settings: max error {worst}");
     // Without widening the uneven neighbourhoods are reported, and what is returned is
     // accurate.
-    let fixed_width = torus.errors(&with(Settings {
-        max_widening: 1.0,
-        ..Settings::new(2, 2)
-    }));
+    let fixed_width = torus_errors(
+        &torus,
+        &with(Settings {
+            max_widening: 1.0,
+            ..Settings::new(2, 2)
+        }),
+    );
     let reported = fixed_width
         .iter()
         .filter(|e| matches!(e, Err(ManifoldError::IllConditioned { .. })))
@@ -154,11 +88,14 @@ fn anisotropic_torus_is_accurate_or_reported() {
     }
     // Accepting any condition number brings the large errors back: the indicator is what
     // separates them.
-    let unchecked = torus.errors(&with(Settings {
-        max_widening: 1.0,
-        max_condition: 1e15,
-        ..Settings::new(2, 2)
-    }));
+    let unchecked = torus_errors(
+        &torus,
+        &with(Settings {
+            max_widening: 1.0,
+            max_condition: 1e15,
+            ..Settings::new(2, 2)
+        }),
+    );
     let worst = unchecked.iter().flatten().copied().fold(0.0, f64::max);
     assert!(worst > 0.1, "unchecked fits: max error only {worst}");
     // Wide bandwidths (factor c up to 30) and a much coarser torus never fail.
@@ -171,7 +108,7 @@ fn anisotropic_torus_is_accurate_or_reported() {
                     ..Settings::new(2, degree)
                 };
                 let mls = ManifoldMls::new(cloud.clone(), settings).unwrap();
-                for e in torus.errors(&mls) {
+                for e in torus_errors(&torus, &mls) {
                     assert!(e.is_ok(), "{ku}×{kv}, c = {factor}, m = {degree}: {e:?}");
                 }
             }
@@ -353,27 +290,7 @@ fn edges_of_the_api() {
 #[test]
 fn scan_replaces_the_tree_when_the_projection_keeps_little() {
     let n = 100;
-    let mut rng = common::Lcg(11);
-    let directions: Vec<Vec<f64>> = (0..16)
-        .map(|_| (0..n).map(|_| rng.normal()).collect())
-        .collect();
-    let mut coords = Vec::new();
-    for i in 0..3000 {
-        let (u, v) = (TAU * rng.next(), TAU * rng.next());
-        let features: Vec<f64> = (0..16)
-            .map(|k| {
-                let f = (k / 4 + 1) as f64;
-                match k % 4 {
-                    0 => (f * u).cos(),
-                    1 => (f * u).sin(),
-                    2 => (f * v).cos(),
-                    _ => (f * v).sin(),
-                }
-            })
-            .collect();
-        let _ = i;
-        coords.extend((0..n).map(|j| (0..16).map(|k| directions[k][j] * features[k]).sum::<f64>()));
-    }
+    let coords = common::spread_torus(n, 3000, 11);
     let cloud = PointCloud::from_points(n, coords).unwrap();
     let index = NeighbourIndex::new(&cloud);
     assert_eq!(index.strategy(), SearchStrategy::Scan);
