@@ -13,6 +13,18 @@ fn umls(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
+/// Runs `umls` and requires success, showing its stderr otherwise.
+fn umls_ok(args: &[&str]) -> Output {
+    let out = umls(args);
+    assert!(
+        out.status.success(),
+        "`umls {}`: {}",
+        args.join(" "),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 fn scratch(name: &str) -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join("binary")
@@ -94,7 +106,7 @@ fn history(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
 #[test]
 fn vibrating_bar_writes_readable_files() {
     let dir = scratch("bar");
-    let out = umls(&[
+    let out = umls_ok(&[
         "run",
         "vibrating-bar",
         "--out",
@@ -103,11 +115,6 @@ fn vibrating_bar_writes_readable_files() {
         "2.5",
         "--quiet",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("velocity_rmse"), "{stdout}");
 
@@ -316,17 +323,12 @@ plane = { point = [0.0, 0.0], normal = [-1.0, 0.0] }
 "#,
     )
     .unwrap();
-    let out = umls(&[
+    umls_ok(&[
         "run",
         file.to_str().unwrap(),
         "--out",
         dir.join("out").to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let s = summary(&dir.join("out"));
     assert_eq!(s["kernel"], "bspline2");
     assert_eq!(s["materials"], serde_json::json!(["sand", "block"]));
@@ -625,18 +627,13 @@ plane = {{ point = [0.0, 0.0], normal = [0.0, 1.0] }}
         let file = dir.join(format!("{name}.toml"));
         std::fs::write(&file, text).unwrap();
         let out_dir = dir.join(name);
-        let out = umls(&[
+        umls_ok(&[
             "run",
             file.to_str().unwrap(),
             "--out",
             out_dir.to_str().unwrap(),
             "--quiet",
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         (summary(&out_dir), history(&out_dir))
     };
     let (ramped, (header, rows)) = run("ramped", column("", "gravity_ramp = 0.1"));
@@ -727,17 +724,12 @@ fn three_dimensional_gmsh_scene_with_group_slip() {
     ] {
         let dir = scratch(&format!("cube-{name}"));
         let file = scene_with_fixtures(&dir, "block.toml", &text);
-        let out = umls(&[
+        umls_ok(&[
             "run",
             file.to_str().unwrap(),
             "--out",
             dir.join("out").to_str().unwrap(),
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         let s = summary(&dir.join("out"));
         assert_eq!(
             (s["dimension"].as_u64(), s["particles"].as_u64()),
@@ -803,7 +795,7 @@ seeding = { mesh = "gauss2" }
 velocity = ["y", "-x"]
 "#,
     );
-    let out = umls(&[
+    umls_ok(&[
         "run",
         file.to_str().unwrap(),
         "--out",
@@ -811,11 +803,6 @@ velocity = ["y", "-x"]
         "--kernel",
         "linear-fe",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let s = summary(&dir.join("out"));
     // 44 triangles × 3 Gauss points; the mass is density × area.
     assert_eq!(s["particles"], 132);
@@ -978,7 +965,7 @@ fn a_clipped_body_is_reported() {
         1,
     );
     std::fs::write(&file, text).unwrap();
-    let out = umls(&[
+    let out = umls_ok(&[
         "run",
         file.to_str().unwrap(),
         "--end-time",
@@ -987,11 +974,6 @@ fn a_clipped_body_is_reported() {
         dir.join("out").to_str().unwrap(),
         "--quiet",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("warning: bodies[0]") && err.contains("outside the mesh"),
@@ -1017,7 +999,7 @@ fn a_run_clears_the_files_of_an_earlier_run() {
     }
     std::fs::write(dir.join("notes.txt"), "mine").unwrap();
     std::fs::write(dir.join("particles_final.vtu"), "mine too").unwrap();
-    let out = umls(&[
+    umls_ok(&[
         "run",
         "vibrating-bar",
         "--kernel",
@@ -1028,11 +1010,6 @@ fn a_run_clears_the_files_of_an_earlier_run() {
         dir.to_str().unwrap(),
         "--quiet",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     assert!(!dir.join("particles_00099.vtu").exists());
     assert!(!dir.join("grid.vtu").exists());
     assert_eq!(
@@ -1057,7 +1034,7 @@ fn a_run_clears_the_files_of_an_earlier_run() {
 #[test]
 fn two_dimensional_tensors_are_plane_strain() {
     let dir = scratch("plane-strain");
-    let out = umls(&[
+    umls_ok(&[
         "run",
         "colliding-disks",
         "--end-time",
@@ -1066,11 +1043,6 @@ fn two_dimensional_tensors_are_plane_strain() {
         dir.to_str().unwrap(),
         "--quiet",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let (_, last) = frames(&dir).pop().unwrap();
     let (n, arrays) = point_arrays(&dir.join(last));
     let get = |name: &str| &arrays.iter().find(|(a, _)| a == name).unwrap().1;
