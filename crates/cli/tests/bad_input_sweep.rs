@@ -6,10 +6,12 @@
 //! is: the file and line, or the key.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Output;
+use std::time::Duration;
 
 use umls_cli::builtin::BUILTIN;
+
+mod common;
 
 const LIMIT: Duration = Duration::from_secs(60);
 
@@ -22,23 +24,9 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// Runs `umls`, killing it after [`LIMIT`]: a hang fails the test instead of stalling it.
+/// Runs `umls` with the sweep's time limit.
 fn umls(args: &[&str]) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_umls"))
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the binary runs");
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > LIMIT {
-            let _ = child.kill();
-            panic!("`umls {}` did not finish within {LIMIT:?}", args.join(" "));
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    child.wait_with_output().unwrap()
+    common::umls_within(args, LIMIT)
 }
 
 /// A failed run: non-zero status, no panic, and the message of stderr.

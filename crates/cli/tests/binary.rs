@@ -4,7 +4,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use common::umls_within;
 use vtkio::model::{Attribute, DataSet, Piece};
+
+mod common;
 
 fn umls(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_umls"))
@@ -815,26 +818,6 @@ velocity = ["y", "-x"]
         "kinetic {}",
         rows[0][2]
     );
-}
-
-/// Runs `umls` with `args`, killing it after `limit` (a hang is a failure, not a stuck
-/// test suite).
-fn umls_within(args: &[&str], limit: std::time::Duration) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_umls"))
-        .args(args)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("the binary runs");
-    let start = std::time::Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            panic!("`umls {}` did not finish within {limit:?}", args.join(" "));
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    child.wait_with_output().unwrap()
 }
 
 /// Inputs that used to hang or name the wrong key: an infinite initial velocity, an
