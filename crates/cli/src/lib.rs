@@ -27,9 +27,12 @@
 //! # Ok::<(), umls_cli::CliError>(())
 //! ```
 
+pub mod background;
 pub mod builtin;
 mod error;
 pub mod expression;
+pub mod frame;
+pub mod hydrostatic;
 pub mod mesh_info;
 mod output;
 pub mod plot;

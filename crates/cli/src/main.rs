@@ -105,8 +105,13 @@ fn main() -> ExitCode {
                     println!("  {k}: {v}");
                 }
             }
+            let background = if report.summary["outputs"]["mesh"].is_null() {
+                "grid.vtu"
+            } else {
+                "mesh.vtu"
+            };
             println!(
-                "wrote {} (open particles.pvd and mesh.vtu in ParaView)",
+                "wrote {} (open particles.pvd and {background} in ParaView)",
                 report.out.display()
             );
             Ok(())

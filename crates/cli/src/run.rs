@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 use serde_json::json;
 use umls_engine::{
     Apic, Boundary, Diagnostics, EngineError, Flip, Particles, Simulation, StageTimes,
@@ -167,23 +167,32 @@ fn run_dim<const D: usize, X: Dimension<D>>(
     scene: &Scene,
     options: &RunOptions,
 ) -> Result<RunReport> {
-    let setup = setup::build::<D>(scene, X::SPLIT)?;
+    let kernel = options.kernel.unwrap_or(scene.spec.kernel.kind);
+    let grid_kernel = matches!(kernel, KernelKind::Bspline2 | KernelKind::Bspline3);
+    let setup = setup::build_for::<D>(scene, X::SPLIT, grid_kernel)?;
     let encoding = match scene.spec.output.encoding {
         EncodingSpec::Binary => Encoding::Binary,
         EncodingSpec::Ascii => Encoding::Ascii,
     };
     let ctx = Context {
         scene,
-        kernel: options.kernel.unwrap_or(scene.spec.kernel.kind),
+        kernel,
         end_time: options.end_time.unwrap_or(scene.spec.scene.end_time),
         setup,
         options,
         encoding,
     };
-    let mesh = ctx.setup.mesh.clone();
+    let mesh = || {
+        ctx.setup.background.mesh().cloned().ok_or_else(|| {
+            scene.value_error(
+                "kernel.kind",
+                "a mesh kernel needs the mesh (none was built)",
+            )
+        })
+    };
     match ctx.kernel {
-        KernelKind::Umls => with_kernel::<D, X, _>(&ctx, X::umls(mesh)),
-        KernelKind::LinearFe => with_kernel::<D, X, _>(&ctx, LinearFeKernel::new(mesh)),
+        KernelKind::Umls => with_kernel::<D, X, _>(&ctx, X::umls(mesh()?)),
+        KernelKind::LinearFe => with_kernel::<D, X, _>(&ctx, LinearFeKernel::new(mesh()?)),
         KernelKind::Bspline2 => {
             with_kernel::<D, X, _>(&ctx, bspline(&ctx, BSplineOrder::Quadratic)?)
         }
@@ -197,20 +206,25 @@ const MAX_GRID_NODES: f64 = 1e8;
 /// A B-spline grid covering the mesh's bounding box with two cells of margin (the
 /// widest, cubic, stencil needs one).
 fn bspline<const D: usize>(ctx: &Context<'_, D>, order: BSplineOrder) -> Result<BSplineKernel<D>> {
-    let mesh = &ctx.setup.mesh;
+    let background = &ctx.setup.background;
     let h = ctx
         .scene
         .spec
         .kernel
         .grid_spacing
         .or(ctx.setup.lattice_spacing)
-        .unwrap_or_else(|| mesh.max_edge_length() / (D as f64).sqrt());
+        .or_else(|| {
+            background
+                .mesh()
+                .map(|mesh| mesh.max_edge_length() / (D as f64).sqrt())
+        })
+        .unwrap_or(f64::NAN);
     if !(h.is_finite() && h > 0.0) {
         return Err(ctx
             .scene
             .value_error("kernel.grid_spacing", "must be positive"));
     }
-    let (lower, upper) = mesh.bounding_box();
+    let (lower, upper) = background.bounding_box();
     let kernel = BSplineKernel::covering(lower, upper, h, order).ok_or_else(|| {
         ctx.scene
             .value_error("kernel.grid_spacing", "too coarse for one B-spline stencil")
@@ -349,6 +363,8 @@ trait Run<const D: usize> {
     fn node_count(&self) -> usize;
     fn last_dt(&self) -> f64;
     fn stage_times(&self) -> StageTimes;
+    /// Cauchy stresses σ = τ / det F.
+    fn cauchy_stresses(&self) -> std::result::Result<Vec<SMatrix<f64, D, D>>, EngineError>;
 }
 
 impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
@@ -412,6 +428,13 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
     }
     fn stage_times(&self) -> StageTimes {
         *Simulation::stage_times(self)
+    }
+    fn cauchy_stresses(&self) -> std::result::Result<Vec<SMatrix<f64, D, D>>, EngineError> {
+        let mut stresses = self.stresses()?;
+        for (tau, f) in stresses.iter_mut().zip(&self.particles.deformation) {
+            *tau /= umls_constitutive::determinant(f);
+        }
+        Ok(stresses)
     }
 }
 
@@ -480,9 +503,11 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
             return Ok(None);
         };
         let mut sum = 0.0;
+        let frame = &setup.frame;
         for (v, x0) in sim.velocities().iter().zip(&reference_positions) {
             let exact = field
-                .eval(x0, sim.time())
+                .eval(&frame.point_to_scene(x0), sim.time())
+                .map(|v| frame.vector_to_world(&v))
                 .map_err(|reason| scene.value_error("reference.velocity", reason))?;
             sum += (v - exact).norm_squared();
         }
@@ -560,10 +585,15 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     }
     history.flush()?;
     let (mass, velocity) = sim.grid();
+    let mesh = setup.background.mesh();
     if mesh_kernel {
-        out.write_mesh(&setup.mesh, &setup.groups, Some((mass, velocity)))?;
+        if let Some(mesh) = mesh {
+            out.write_mesh(mesh, &setup.groups, Some((mass, velocity)))?;
+        }
     } else {
-        out.write_mesh(&setup.mesh, &setup.groups, None)?;
+        if let Some(mesh) = mesh {
+            out.write_mesh(mesh, &setup.groups, None)?;
+        }
         let nodes = sim.node_positions();
         out.write_grid(&nodes, mass, velocity)?;
     }
@@ -607,6 +637,15 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         );
         metrics.insert("velocity_error_max".into(), json!(error_max));
     }
+    if let (Some(column), None) = (&setup.hydrostatic, &failure) {
+        let stresses = sim.cauchy_stresses()?;
+        metrics.extend(column.metrics(
+            &setup.frame,
+            &reference_positions,
+            sim.positions(),
+            &stresses,
+        ));
+    }
     let summary = json!({
         "scene": spec.scene.name,
         "source": scene.label,
@@ -617,7 +656,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         "materials": setup.material_names,
         "particles": sim.positions().len(),
         "nodes": sim.node_count(),
-        "cells": setup.mesh.simplex_count(),
+        "cells": setup.background.cell_count(),
         "dt": sim.last_dt(),
         "time_step": match sim.settings().time_step {
             TimeStepControl::Fixed => "fixed",
@@ -644,7 +683,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         "outputs": {
             "particles": "particles.pvd",
             "frames": out.frames(),
-            "mesh": "mesh.vtu",
+            "mesh": mesh.map(|_| "mesh.vtu"),
             "grid": if mesh_kernel { None } else { Some("grid.vtu") },
             "history": "history.csv",
             "energy_plot": "energies.svg",

@@ -35,6 +35,21 @@ pub struct SceneSpec {
     pub damping: Option<DampingSpec>,
     /// Initial stress of the particles.
     pub initial_stress: Option<InitialStressSpec>,
+    /// A rotation of the whole scene into the world frame.
+    pub transform: Option<TransformSpec>,
+}
+
+/// `[transform]`: the scene as written is turned by `rotation` degrees (counter-clockwise
+/// about `axis` through `centre`) before it runs.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransformSpec {
+    /// Angle in degrees.
+    pub rotation: f64,
+    /// 3D: the axis (default z); 2D scenes turn about z and take no axis.
+    pub axis: Option<Vec<f64>>,
+    /// The fixed point (default: the origin).
+    pub centre: Option<Vec<f64>>,
 }
 
 /// `[damping]`: exactly one of `local` (Cundall's α) and `mass` (β in 1/s).
@@ -504,12 +519,31 @@ pub struct BoundarySpec {
     pub group: Option<String>,
 }
 
-/// `[reference]`: an analytic velocity field v(X, t) at the particles' initial positions X.
+/// `[reference]`: an analytic velocity field v(X, t) at the particles' initial positions
+/// X, or the hydrostatic stress of a column at rest under gravity (at least one).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReferenceSpec {
     /// D expressions in x, y, z (initial position) and t.
-    pub velocity: Vec<Component>,
+    pub velocity: Option<Vec<Component>>,
     /// Velocity scale the RMSE is divided by (default: the largest |v(X, 0)|).
     pub scale: Option<f64>,
+    /// The column's exact stress at the end of the run.
+    pub hydrostatic: Option<HydrostaticSpec>,
+}
+
+/// `[reference.hydrostatic]`: a laterally confined elastic column at rest under gravity.
+/// Levels are heights along −g in the scene frame (before `[transform]`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HydrostaticSpec {
+    /// Level of the free surface.
+    pub surface: f64,
+    /// Level of the base.
+    pub base: f64,
+    /// Particles within this distance of the surface or the base are not interior
+    /// (default: a tenth of the column's height).
+    pub margin: Option<f64>,
+    /// Thickness of the bottom and top rows (default: the first body's lattice spacing).
+    pub row: Option<f64>,
 }

@@ -13,8 +13,11 @@ use umls_io::gmsh::{PhysicalGroup, ReadOptions, parse_msh};
 use umls_mesh::generate::{Diagonal, Lattice};
 use umls_mesh::{Orientation, SampleRule, SimplexMesh};
 
+use crate::background::Background;
 use crate::error::{CliError, Result};
 use crate::expression::VectorField;
+use crate::frame::SceneFrame;
+use crate::hydrostatic::Hydrostatic;
 use crate::scene::Scene;
 use crate::schema::{
     BoundaryKind, DiagonalSpec, MaterialSpec, QuadratureSpec, RegionSpec, SeedingSpec, SolidSpec,
@@ -60,8 +63,8 @@ pub enum BoundaryTarget<const D: usize> {
 /// Everything a D-dimensional run needs besides the kernel, material and transfer types.
 #[derive(Debug, Clone)]
 pub struct Setup<const D: usize> {
-    /// The background mesh.
-    pub mesh: Arc<SimplexMesh<D>>,
+    /// The background: a mesh, or the box of a lattice no kernel reads as simplices.
+    pub background: Background<D>,
     /// Cell size of a lattice mesh (B-spline grids default to it).
     pub lattice_spacing: Option<f64>,
     /// Physical groups of a file mesh.
@@ -86,8 +89,13 @@ pub struct Setup<const D: usize> {
     pub geostatic_k0: Option<f64>,
     /// What the user should hear about the setup (a body clipped by the mesh, …).
     pub warnings: Vec<String>,
-    /// The analytic velocity v(X, t), and the scale its RMSE is divided by.
+    /// The analytic velocity v(X, t) (scene frame), and the scale its RMSE is divided by.
     pub reference: Option<(VectorField<D>, f64)>,
+    /// The hydrostatic column's closed form (scene frame).
+    pub hydrostatic: Option<Hydrostatic<D>>,
+    /// The rotation from the scene as written into the world it runs in; everything
+    /// above except the references is already in the world frame.
+    pub frame: SceneFrame<D>,
 }
 
 impl<const D: usize> Setup<D> {
@@ -97,7 +105,12 @@ impl<const D: usize> Setup<D> {
     }
 }
 
-fn vector<const D: usize>(scene: &Scene, key: &str, values: &[f64]) -> Result<SVector<f64, D>> {
+/// A D-vector from the file's list at `key`: D finite components.
+pub(crate) fn vector<const D: usize>(
+    scene: &Scene,
+    key: &str,
+    values: &[f64],
+) -> Result<SVector<f64, D>> {
     if values.len() != D {
         return Err(scene.value_error(
             key,
@@ -142,10 +155,13 @@ pub fn tetrahedra(
     l.tetrahedra()
 }
 
-fn mesh<const D: usize>(
+/// The scene's background; a lattice is split into simplices unless `lean` (a grid
+/// kernel, no mesh seeding) says no one will read them.
+fn background<const D: usize>(
     scene: &Scene,
     split: Split<D>,
-) -> Result<(SimplexMesh<D>, Option<f64>, Vec<PhysicalGroup>)> {
+    lean: bool,
+) -> Result<(Background<D>, Option<f64>, Vec<PhysicalGroup>)> {
     let spec = &scene.spec.mesh;
     match (&spec.file, &spec.lattice) {
         (Some(file), None) => {
@@ -158,7 +174,7 @@ fn mesh<const D: usize>(
             };
             let read = parse_msh::<D>(&scene.mesh_bytes(file)?, options)
                 .map_err(|e| scene.value_error("mesh.file", format!("{file}: {e}")))?;
-            Ok((read.mesh, None, read.groups))
+            Ok((Background::Mesh(Arc::new(read.mesh)), None, read.groups))
         }
         (None, Some(l)) => {
             let lower: SVector<f64, D> = vector(scene, "mesh.lattice.lower", &l.lower)?;
@@ -189,9 +205,27 @@ fn mesh<const D: usize>(
                 DiagonalSpec::Left => Diagonal::Left,
                 DiagonalSpec::Crossed => Diagonal::Crossed,
             };
+            if lean {
+                if (0..D).any(|k| upper[k] <= lower[k]) {
+                    return Err(scene.value_error(
+                        "mesh.lattice",
+                        "`upper` must exceed `lower` in every component",
+                    ));
+                }
+                let frame = SceneFrame::default();
+                return Ok((
+                    Background::Box {
+                        lower,
+                        upper,
+                        frame,
+                    },
+                    Some(spacing),
+                    Vec::new(),
+                ));
+            }
             let mesh = split(&lattice, diagonal)
                 .map_err(|e| scene.value_error("mesh.lattice", e.to_string()))?;
-            Ok((mesh, Some(spacing), Vec::new()))
+            Ok((Background::Mesh(Arc::new(mesh)), Some(spacing), Vec::new()))
         }
         _ => Err(scene.value_error("mesh", "give exactly one of `file` and `lattice`")),
     }
@@ -304,7 +338,7 @@ fn group<'a>(
 fn seed_body<const D: usize>(
     scene: &Scene,
     index: usize,
-    mesh: &SimplexMesh<D>,
+    background: &Background<D>,
     groups: &[PhysicalGroup],
     material: u16,
     seeds: &mut Seeds<D>,
@@ -359,7 +393,7 @@ fn seed_body<const D: usize>(
             if !(h.is_finite() && *h > 0.0) {
                 return Err(scene.value_error(key("seeding.lattice"), "spacing must be positive"));
             }
-            let (lower, upper) = mesh.bounding_box();
+            let (lower, upper) = background.bounding_box();
             let count: f64 = (0..D)
                 .map(|k| ((upper[k] - lower[k]) / h).round().max(1.0))
                 .product();
@@ -373,13 +407,16 @@ fn seed_body<const D: usize>(
             // non-convex Gmsh domain) would stop the run at its first step.
             lattice_samples(lower, upper, *h)
                 .into_iter()
-                .filter(|(x, _)| mesh.locate(x).is_some())
+                .filter(|(x, _)| background.contains(x))
                 .collect()
         }
         SeedingSpec::Mesh(rule) => {
             let rule = match rule {
                 QuadratureSpec::Centroid => SampleRule::Centroid,
                 QuadratureSpec::Gauss2 => SampleRule::Gauss2,
+            };
+            let Some(mesh) = background.mesh() else {
+                return Err(scene.value_error(key("seeding"), "mesh seeding needs the mesh"));
             };
             let all = mesh.sample_points(rule);
             match cells {
@@ -459,10 +496,26 @@ fn seed_body<const D: usize>(
     }))
 }
 
-/// Builds the D-dimensional setup of `scene`.
+/// Builds the D-dimensional setup of `scene`, with its mesh.
 pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>> {
+    build_for(scene, split, false)
+}
+
+/// Builds the D-dimensional setup of `scene`; `grid_kernel` says the run's kernel reads
+/// only the background's box, so a `[mesh.lattice]` is not split into simplices unless a
+/// body is seeded at mesh quadrature points.
+pub fn build_for<const D: usize>(
+    scene: &Scene,
+    split: Split<D>,
+    grid_kernel: bool,
+) -> Result<Setup<D>> {
     let spec = &scene.spec;
-    let (mesh, lattice_spacing, groups) = mesh::<D>(scene, split)?;
+    let lean = grid_kernel
+        && spec
+            .bodies
+            .iter()
+            .all(|b| matches!(b.seeding, SeedingSpec::Lattice(_)));
+    let (background, lattice_spacing, groups) = background::<D>(scene, split, lean)?;
     if spec.materials.is_empty() {
         return Err(scene.value_error("materials", "at least one material is needed"));
     }
@@ -499,7 +552,7 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
         warnings.extend(seed_body(
             scene,
             i,
-            &mesh,
+            &background,
             &groups,
             material as u16,
             &mut seeds,
@@ -525,6 +578,12 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
             }
             (None, Some(name)) => {
                 let g = group(scene, &groups, &format!("boundaries[{i}].group"), name)?;
+                let Some(mesh) = background.mesh() else {
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].group"),
+                        "a group needs the mesh it belongs to",
+                    ));
+                };
                 BoundaryTarget::Vertices(
                     g.vertices
                         .iter()
@@ -583,12 +642,12 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
         }
         Some(i) => Some(i.geostatic_k0),
     };
-    let reference = match &spec.reference {
+    let reference = match spec.reference.as_ref().and_then(|r| r.velocity.as_ref()) {
         None => None,
-        Some(r) => {
-            let field = VectorField::<D>::compile(&r.velocity, true)
+        Some(velocity) => {
+            let field = VectorField::<D>::compile(velocity, true)
                 .map_err(|reason| scene.value_error("reference.velocity", reason))?;
-            let scale = match r.scale {
+            let scale = match spec.reference.as_ref().and_then(|r| r.scale) {
                 Some(s) if s.is_finite() && s > 0.0 => s,
                 Some(_) => return Err(scene.value_error("reference.scale", "must be positive")),
                 None => {
@@ -611,8 +670,61 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
             Some((field, scale))
         }
     };
+    let hydrostatic = match spec.reference.as_ref() {
+        Some(r) if r.velocity.is_none() && r.hydrostatic.is_none() => {
+            return Err(scene.value_error("reference", "give `velocity`, `hydrostatic`, or both"));
+        }
+        Some(r) if r.velocity.is_none() && r.scale.is_some() => {
+            return Err(scene.value_error(
+                "reference.scale",
+                "scales `reference.velocity`, which is not given",
+            ));
+        }
+        Some(r) => match &r.hydrostatic {
+            Some(h) => Some(Hydrostatic::new(scene, h, &gravity, &seeds)?),
+            None => None,
+        },
+        None => None,
+    };
+    let frame = SceneFrame::<D>::from_scene(scene)?;
+    let mut background = background;
+    let mut gravity = gravity;
+    if !frame.is_identity() {
+        background = match background {
+            Background::Mesh(mesh) => Background::Mesh(Arc::new(
+                frame
+                    .mesh_to_world(&mesh)
+                    .map_err(|e| scene.value_error("transform", e.to_string()))?,
+            )),
+            Background::Box { lower, upper, .. } => Background::Box {
+                lower,
+                upper,
+                frame,
+            },
+        };
+        gravity = frame.vector_to_world(&gravity);
+        for x in &mut seeds.position {
+            *x = frame.point_to_world(x);
+        }
+        for v in &mut seeds.velocity {
+            *v = frame.vector_to_world(v);
+        }
+        for (_, target) in &mut boundaries {
+            match target {
+                BoundaryTarget::Plane { point, normal } => {
+                    *point = frame.point_to_world(point);
+                    *normal = frame.vector_to_world(normal);
+                }
+                BoundaryTarget::Vertices(vertices) => {
+                    for (_, normal) in vertices {
+                        *normal = frame.vector_to_world(normal);
+                    }
+                }
+            }
+        }
+    }
     Ok(Setup {
-        mesh: Arc::new(mesh),
+        background,
         lattice_spacing,
         groups,
         seeds,
@@ -626,6 +738,8 @@ pub fn build<const D: usize>(scene: &Scene, split: Split<D>) -> Result<Setup<D>>
         geostatic_k0,
         warnings,
         reference,
+        hydrostatic,
+        frame,
     })
 }
 

@@ -39,9 +39,10 @@ fn disks_file_builds_the_hand_written_scene() {
     assert!(offset < 1e-15, "{offset}");
     assert_eq!(setup.seeds.velocity, particles.velocity);
     assert_eq!(setup.seeds.mass, particles.mass);
-    assert_eq!(setup.mesh.vertices(), reference.mesh().unwrap().vertices());
+    let mesh = setup.background.mesh().unwrap();
+    assert_eq!(mesh.vertices(), reference.mesh().unwrap().vertices());
     assert_eq!(
-        setup.mesh.connectivity(),
+        mesh.connectivity(),
         reference.mesh().unwrap().connectivity()
     );
 }
@@ -172,6 +173,48 @@ fn unknown_keys_are_named() {
 #[test]
 fn bad_values_name_their_key() {
     for (scene, find, replace, key) in [
+        (
+            "hydrostatic-column-tilted",
+            "rotation = 30.0",
+            "rotation = 30.0\naxis = [0.0, 0.0, 1.0]",
+            "`transform.axis`",
+        ),
+        (
+            "hydrostatic-column-3d",
+            "[reference.hydrostatic]",
+            "[transform]\nrotation = 10.0\naxis = [0.0, 0.0, 0.0]\n\n[reference.hydrostatic]",
+            "`transform.axis`",
+        ),
+        (
+            "hydrostatic-column",
+            "base = 0.0",
+            "base = 4.5",
+            "`reference.hydrostatic.surface`",
+        ),
+        (
+            "hydrostatic-column",
+            "base = 0.0",
+            "base = 0.0\nmargin = 2.5",
+            "`reference.hydrostatic.margin`",
+        ),
+        (
+            "hydrostatic-column",
+            "surface = 4.0",
+            "surface = 8.0",
+            "`reference.hydrostatic.row`",
+        ),
+        (
+            "hydrostatic-column",
+            "model = \"linear-elastic\"\ndensity = 1000.0\nyoung = 1e8\npoisson = 0.3",
+            "model = \"fluid\"\ndensity = 1000.0\nbulk = 1e8",
+            "`reference.hydrostatic`",
+        ),
+        (
+            "hydrostatic-column",
+            "[reference.hydrostatic]\nsurface = 4.0\nbase = 0.0",
+            "[reference]\nscale = 2.0",
+            "`reference`",
+        ),
         (
             "colliding-disks",
             "material = \"elastic\"",

@@ -7,7 +7,17 @@
 use proptest::prelude::*;
 use umls_cli::builtin::BUILTIN;
 use umls_cli::scene::Scene;
-use umls_cli::setup::{build, segments, tetrahedra, triangles};
+use umls_cli::schema::KernelKind;
+use umls_cli::setup::{build_for, segments, tetrahedra, triangles};
+
+/// Whether `umls run` would build this scene for a grid kernel (no simplices for a
+/// lattice): the fuzz builds what a run builds.
+fn grid(scene: &Scene) -> bool {
+    matches!(
+        scene.spec.kernel.kind,
+        KernelKind::Bspline2 | KernelKind::Bspline3
+    )
+}
 
 /// Byte ranges of the numeric literals of a scene text (outside comments and strings).
 fn numbers(text: &str) -> Vec<(usize, usize)> {
@@ -66,9 +76,9 @@ proptest! {
         if let Ok(scene) = Scene::parse(&text, "fuzz.toml", None) {
             // A scene whose dimension was changed builds for the dimension it claims.
             let _ = match scene.spec.scene.dimension {
-                1 => build::<1>(&scene, segments).map(|s| s.seeds.position.len()),
-                2 => build::<2>(&scene, triangles).map(|s| s.seeds.position.len()),
-                3 => build::<3>(&scene, tetrahedra).map(|s| s.seeds.position.len()),
+                1 => build_for::<1>(&scene, segments, grid(&scene)).map(|s| s.seeds.position.len()),
+                2 => build_for::<2>(&scene, triangles, grid(&scene)).map(|s| s.seeds.position.len()),
+                3 => build_for::<3>(&scene, tetrahedra, grid(&scene)).map(|s| s.seeds.position.len()),
                 _ => Ok(0),
             };
         }
@@ -109,9 +119,9 @@ fn every_number_of_every_scene_with_hostile_values() {
                 let result =
                     Scene::parse(&text, "edited.toml", None).and_then(|scene| {
                         match scene.spec.scene.dimension {
-                            1 => build::<1>(&scene, segments).map(drop),
-                            2 => build::<2>(&scene, triangles).map(drop),
-                            3 => build::<3>(&scene, tetrahedra).map(drop),
+                            1 => build_for::<1>(&scene, segments, grid(&scene)).map(drop),
+                            2 => build_for::<2>(&scene, triangles, grid(&scene)).map(drop),
+                            3 => build_for::<3>(&scene, tetrahedra, grid(&scene)).map(drop),
                             _ => Ok(()),
                         }
                     });

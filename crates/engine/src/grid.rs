@@ -108,6 +108,24 @@ impl<const D: usize> Grid<D> {
             scaled_nodes: 0,
         };
         let mut active_mass = 0.0;
+        if let Damping::Local { .. } = damping {
+            // Local damping acts per component on the force the node is free to follow:
+            // the part a wall takes (fixed, or normal to a slip wall) must not be damped,
+            // or a wall's reaction becomes a friction-like force along an inclined wall
+            // that overshoots every step (an inclined column crept down its walls).
+            // Projecting the force before the update changes nothing else: the
+            // velocity is projected after it anyway.
+            for i in 0..self.mass.len() {
+                let m = self.mass[i];
+                self.velocity[i] = if m != 0.0 {
+                    self.momentum[i] / m
+                } else {
+                    SVector::zeros()
+                };
+            }
+            boundary.apply(&mut self.velocity);
+            boundary.apply(&mut self.force);
+        }
         for i in 0..self.mass.len() {
             let m = self.mass[i];
             if !self.is_active(i, cancellation_fraction) {
@@ -120,7 +138,10 @@ impl<const D: usize> Grid<D> {
             }
             active_mass += m;
             let v = self.momentum[i] / m;
-            let f = damped(self.force[i], v, m, damping);
+            let f = match damping {
+                Damping::Local { .. } => damped(self.force[i], self.velocity[i], m, damping),
+                _ => damped(self.force[i], v, m, damping),
+            };
             let scaled_mass = dt * dt * modulus * self.stiffness[i];
             self.velocity[i] = v;
             if scaled_mass > m.abs() {

@@ -1,0 +1,84 @@
+//! The `fluid-box-3d` scene (Taichi's mpm3d) and the grid kernels' lean background: a
+//! B-spline run of a `[mesh.lattice]` scene never splits the lattice into simplices.
+
+use umls_cli::run::{RunOptions, run};
+use umls_cli::scene::Scene;
+use umls_cli::setup::{build, build_for, tetrahedra, triangles};
+
+/// The first 25 steps: the block is in free fall (it is 0.1 above the floor plane), so
+/// its momentum is −M g t along y to round-off and nothing else moves it; no mesh is
+/// built or written.
+#[test]
+fn fluid_box_falls_freely_at_first_without_a_mesh() {
+    let scene = Scene::load("fluid-box-3d").unwrap();
+    let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("fluid-box");
+    let options = RunOptions {
+        kernel: None,
+        out: out.clone(),
+        end_time: Some(0.005),
+        threads: Some(2),
+        progress: false,
+        interrupt: None,
+    };
+    let report = run(&scene, &options).unwrap();
+    let s = &report.summary;
+    assert_eq!(s["kernel"], "bspline2");
+    assert_eq!(s["particles"], 64_000);
+    assert_eq!(s["steps"], 25);
+    assert!(
+        s["cells"].is_null() && s["outputs"]["mesh"].is_null(),
+        "{s}"
+    );
+    assert!(!out.join("mesh.vtu").exists() && out.join("grid.vtu").exists());
+    let text = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let last: Vec<f64> = text
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let column = |name: &str| last[header.iter().position(|h| *h == name).unwrap()];
+    // 64,000 particles of 10⁻⁶ m³ at density 1 (a sum of 64,000 rounded volumes).
+    let mass = column("mass");
+    assert!((mass - 0.064).abs() < 1e-12 * 0.064, "{mass}");
+    // Sums over 64,000 particles for 25 steps carry ~10⁻¹² relative round-off; touching
+    // a wall or losing mass would show at 10⁻³.
+    let expected = -mass * 9.8 * column("time");
+    assert!(
+        (column("momentum_y") - expected).abs() < 1e-10 * expected.abs(),
+        "{} vs {expected}",
+        column("momentum_y")
+    );
+    assert!(column("momentum_x").abs() < 1e-15 && column("momentum_z").abs() < 1e-15);
+}
+
+/// Without the simplices a grid run seeds the same particles and constrains the same
+/// nodes, upright and turned: the lean background changes only what is built.
+#[test]
+fn lean_background_seeds_what_the_mesh_seeds() {
+    for name in ["hydrostatic-column", "hydrostatic-column-tilted"] {
+        let scene = Scene::load(name).unwrap();
+        let full = build::<2>(&scene, triangles).unwrap();
+        let lean = build_for::<2>(&scene, triangles, true).unwrap();
+        assert!(full.background.mesh().is_some() && lean.background.mesh().is_none());
+        assert_eq!(full.seeds.position, lean.seeds.position, "{name}");
+        assert_eq!(full.seeds.volume, lean.seeds.volume, "{name}");
+        let (a, b) = (
+            full.background.bounding_box(),
+            lean.background.bounding_box(),
+        );
+        assert!(
+            (a.0 - b.0).norm() < 1e-14 && (a.1 - b.1).norm() < 1e-14,
+            "{name}"
+        );
+    }
+    let scene = Scene::load("hydrostatic-column-3d").unwrap();
+    let full = build::<3>(&scene, tetrahedra).unwrap();
+    let lean = build_for::<3>(&scene, tetrahedra, true).unwrap();
+    assert_eq!(full.seeds.position, lean.seeds.position);
+    // A mesh kernel always gets its mesh.
+    let meshed = build_for::<3>(&scene, tetrahedra, false).unwrap();
+    assert_eq!(meshed.background.cell_count(), Some(5 * 5 * 22 * 6));
+}
