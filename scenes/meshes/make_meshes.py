@@ -19,3 +19,18 @@ gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
 gmsh.option.setNumber("Mesh.Binary", 0)
 gmsh.write("cantilever.msh")
 gmsh.finalize()
+
+# cantilever-room.msh: the square room [-3, 7] x [-6, 4] the 4 x 1 cantilever of
+# `cantilever-unstructured.toml` swings in, unstructured triangles of size 0.25 (the
+# structured scene's lattice spacing); no groups (the clamp is a region of nodes).
+gmsh.initialize()
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.model.add("cantilever-room")
+gmsh.model.occ.addRectangle(-3, -6, 0, 10, 10)
+gmsh.model.occ.synchronize()
+gmsh.model.mesh.setSize(gmsh.model.getEntities(0), 0.25)
+gmsh.model.mesh.generate(2)
+gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+gmsh.option.setNumber("Mesh.Binary", 0)
+gmsh.write("cantilever-room.msh")
+gmsh.finalize()

@@ -13,7 +13,7 @@ pub struct Builtin {
 }
 
 /// Every built-in scene.
-pub const BUILTIN: [Builtin; 7] = [
+pub const BUILTIN: [Builtin; 10] = [
     Builtin {
         name: "colliding-disks",
         summary: "two elastic disks collide and rebound (Sulsky et al. 1994) on a jittered triangle mesh",
@@ -25,9 +25,9 @@ pub const BUILTIN: [Builtin; 7] = [
         toml: include_str!("../../../scenes/vibrating-bar.toml"),
     },
     Builtin {
-        name: "cantilever",
+        name: "steel-cantilever",
         summary: "elastic cantilever on an unstructured Gmsh mesh, clamped at the mesh's `wall` group, sagging under gravity",
-        toml: include_str!("../../../scenes/cantilever.toml"),
+        toml: include_str!("../../../scenes/steel-cantilever.toml"),
     },
     Builtin {
         name: "hydrostatic-column",
@@ -49,10 +49,36 @@ pub const BUILTIN: [Builtin; 7] = [
         summary: "Taichi's mpm3d scene: a fluid block falls and splashes in a box (bspline2 on a 64³ grid, 64,000 particles)",
         toml: include_str!("../../../scenes/fluid-box-3d.toml"),
     },
+    Builtin {
+        name: "cantilever",
+        summary: "the UMLS paper's cantilever (4 × 1 neo-Hookean beam, embedded clamp) on a lattice the scene can turn, against a converged tip history",
+        toml: include_str!("../../../scenes/cantilever.toml"),
+    },
+    Builtin {
+        name: "cantilever-unstructured",
+        summary: "the cantilever on an unstructured Gmsh mesh of the same room, which the scene can turn",
+        toml: include_str!("../../../scenes/cantilever-unstructured.toml"),
+    },
+    Builtin {
+        name: "vortex",
+        summary: "generalized vortex manufactured solution: an annulus twisted by a body force, against the exact displacement",
+        toml: include_str!("../../../scenes/vortex.toml"),
+    },
 ];
 
-/// Mesh files the built-in scenes refer to, by the name used in `[mesh] file`.
-pub const MESHES: [(&str, &[u8]); 1] = [(
-    "meshes/cantilever.msh",
-    include_bytes!("../../../scenes/meshes/cantilever.msh"),
-)];
+/// Files the built-in scenes refer to (meshes, reference data), by the name the scene
+/// uses.
+pub const FILES: [(&str, &[u8]); 3] = [
+    (
+        "meshes/cantilever.msh",
+        include_bytes!("../../../scenes/meshes/cantilever.msh"),
+    ),
+    (
+        "meshes/cantilever-room.msh",
+        include_bytes!("../../../scenes/meshes/cantilever-room.msh"),
+    ),
+    (
+        "data/cantilever-tip.csv",
+        include_bytes!("../../../scenes/data/cantilever-tip.csv"),
+    ),
+];

@@ -9,6 +9,7 @@ use umls_mesh::{Orientation, SimplexMesh};
 
 use crate::error::Result;
 use crate::scene::Scene;
+use crate::schema::TransformSpec;
 
 /// A rotation about a centre: world = R (scene − c) + c.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,22 +32,27 @@ impl<const D: usize> Default for SceneFrame<D> {
 impl<const D: usize> SceneFrame<D> {
     /// The frame of the scene's `[transform]` table (the identity without one).
     pub fn from_scene(scene: &Scene) -> Result<Self> {
-        let Some(t) = &scene.spec.transform else {
+        Self::from_spec(scene, "transform", scene.spec.transform.as_ref())
+    }
+
+    /// The frame of a transform table at `key` (the identity without one).
+    pub fn from_spec(scene: &Scene, key: &str, spec: Option<&TransformSpec>) -> Result<Self> {
+        let Some(t) = spec else {
             return Ok(Self::default());
         };
         if !t.rotation.is_finite() {
-            return Err(scene.value_error("transform.rotation", "must be finite"));
+            return Err(scene.value_error(format!("{key}.rotation"), "must be finite"));
         }
         let centre = match &t.centre {
             None => SVector::zeros(),
-            Some(c) => crate::setup::vector(scene, "transform.centre", c)?,
+            Some(c) => crate::setup::vector(scene, &format!("{key}.centre"), c)?,
         };
         let angle = t.rotation.to_radians();
         let rotation = match D {
             2 => {
                 if t.axis.is_some() {
                     return Err(scene.value_error(
-                        "transform.axis",
+                        format!("{key}.axis"),
                         "a 2D scene turns about the z axis; give no axis",
                     ));
                 }
@@ -60,16 +66,16 @@ impl<const D: usize> SceneFrame<D> {
             3 => {
                 let axis: Vector3<f64> = match &t.axis {
                     None => Vector3::z(),
-                    Some(a) => crate::setup::vector(scene, "transform.axis", a)?,
+                    Some(a) => crate::setup::vector(scene, &format!("{key}.axis"), a)?,
                 };
                 let Some(axis) = Unit::try_new(axis, 1e-300) else {
-                    return Err(scene.value_error("transform.axis", "must not be zero"));
+                    return Err(scene.value_error(format!("{key}.axis"), "must not be zero"));
                 };
                 let r = nalgebra::Rotation3::from_axis_angle(&axis, angle);
                 SMatrix::from_fn(|i, j| r[(i, j)])
             }
             _ => {
-                return Err(scene.value_error("transform", "a 1D scene cannot be rotated"));
+                return Err(scene.value_error(key, "a 1D scene cannot be rotated"));
             }
         };
         Ok(Self { rotation, centre })

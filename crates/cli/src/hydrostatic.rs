@@ -84,6 +84,7 @@ impl<const D: usize> Hydrostatic<D> {
             Some(r) => r,
             None => match scene.spec.bodies.first().map(|b| &b.seeding) {
                 Some(SeedingSpec::Lattice(h)) => *h,
+                Some(SeedingSpec::LatticeFrom { spacing, .. }) => *spacing,
                 _ => {
                     return Err(scene.value_error(
                         key("row"),

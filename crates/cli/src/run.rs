@@ -25,7 +25,9 @@ use umls_transfer::Kernel;
 use crate::error::{CliError, Result};
 use crate::output::OutputDir;
 use crate::plot::EnergyRecord;
+use crate::probes::Probes;
 use crate::progress::Progress;
+use crate::reference;
 use crate::scene::Scene;
 use crate::schema::{BoundaryKind, EncodingSpec, KernelKind, TransferKind};
 use crate::setup::{self, BoundaryTarget, Setup, Split};
@@ -336,6 +338,17 @@ fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     settings.stress_update = ctx.setup.stress_update;
     settings.damping = ctx.setup.damping;
     let mut sim = Simulation::new(kernel, table, transfer, particles, settings)?;
+    if let Some(field) = &ctx.setup.body_force {
+        let (field, frame) = (field.clone(), ctx.setup.frame);
+        // An evaluation error (none is expected: the field was evaluated at every
+        // particle before the run) gives NaN, which the engine stops at.
+        sim.body_force = Some(Arc::new(move |x: &SVector<f64, D>, t: f64| {
+            field
+                .eval(&frame.point_to_scene(x), t)
+                .map(|b| frame.vector_to_world(&b))
+                .unwrap_or_else(|_| SVector::from_element(f64::NAN))
+        }));
+    }
     drive(ctx, &mut sim)
 }
 
@@ -471,7 +484,9 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     }
 
     let mut out = OutputDir::create(&ctx.options.out, ctx.encoding)?;
-    let header = history_header(D, setup.reference.is_some());
+    let probes = Probes::new(scene, &setup.frame, &seeds.position)?;
+    let mut header = history_header(D, setup.reference.is_some(), setup.displacement.is_some());
+    header.extend(probes.columns(D));
     let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut history = HistoryWriter::create(out.path("history.csv"), &header_refs)?;
 
@@ -479,13 +494,34 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     let frames = setup::frame_count(scene, ctx.end_time);
     let frame_time = |k: usize| ctx.end_time * k as f64 / (frames - 1) as f64;
     let mut next_frame = 1;
-    let record = |sim: &dyn Run<D>,
-                  history: &mut HistoryWriter,
-                  error: Option<f64>|
+    // A history row; the displacement and probe errors are sampled here, at the rows.
+    let mut displacement_errors: Vec<f64> = Vec::new();
+    let mut probe_error = 0.0f64;
+    let mut record = |sim: &dyn Run<D>,
+                      history: &mut HistoryWriter,
+                      error: Option<f64>|
      -> Result<(f64, Diagnostics<D>, EnergyRecord)> {
         let d = sim.diagnostics()?;
         let (potential, total) = total_energy(&d);
-        let row = history_row(&d, potential, total, error);
+        let displacement = reference::displacement_error(
+            scene,
+            setup,
+            &reference_positions,
+            sim.positions(),
+            sim.time(),
+        )?;
+        displacement_errors.extend(displacement);
+        let mut row = history_row(&d, potential, total, error);
+        row.extend(displacement);
+        for k in 0..probes.len() {
+            let u = probes.displacement(k, &setup.frame, &reference_positions, sim.positions());
+            row.extend(u.iter());
+            if let Some(reference) = setup.probe_reference.as_ref().filter(|r| r.probe == k) {
+                if let Some(exact) = reference.at(sim.time()) {
+                    probe_error = probe_error.max((u - exact).norm() / reference.scale());
+                }
+            }
+        }
         history.row(&row)?;
         let record = EnergyRecord {
             time: d.time,
@@ -497,21 +533,14 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         Ok((total, d, record))
     };
 
-    // The reference error at the current time: RMS over particles of |v − v_ref(X, t)|.
-    let reference_error = |sim: &dyn Run<D>| -> Result<Option<f64>> {
-        let Some((field, scale)) = &setup.reference else {
-            return Ok(None);
-        };
-        let mut sum = 0.0;
-        let frame = &setup.frame;
-        for (v, x0) in sim.velocities().iter().zip(&reference_positions) {
-            let exact = field
-                .eval(&frame.point_to_scene(x0), sim.time())
-                .map(|v| frame.vector_to_world(&v))
-                .map_err(|reason| scene.value_error("reference.velocity", reason))?;
-            sum += (v - exact).norm_squared();
-        }
-        Ok(Some((sum / sim.positions().len() as f64).sqrt() / scale))
+    let reference_error = |sim: &dyn Run<D>| {
+        reference::velocity_error(
+            scene,
+            setup,
+            &reference_positions,
+            sim.velocities(),
+            sim.time(),
+        )
     };
 
     sim.write_particles(&mut out, &reference_positions)?;
@@ -575,8 +604,11 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     progress.finish();
     if failure.is_some() {
         // The state the run stopped in (the last frame may be far behind it), and its
-        // history row.
-        sim.write_particles(&mut out, &reference_positions)?;
+        // history row. A state whose stresses cannot be evaluated (an inverted particle)
+        // has no frame; the summary still says why the run stopped.
+        if let Err(e) = sim.write_particles(&mut out, &reference_positions) {
+            warnings.push(format!("the state the run stopped in has no frame: {e}"));
+        }
         if let Ok((total, d, r)) = record(&*sim, &mut history, None) {
             energies.push(r);
             last_total = total;
@@ -636,6 +668,16 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
             json!((error_sum / taken as f64).sqrt()),
         );
         metrics.insert("velocity_error_max".into(), json!(error_max));
+    }
+    if setup.probe_reference.is_some() {
+        metrics.insert("probe_error_max".into(), json!(probe_error));
+    }
+    if let (Some(&last), Some(max)) = (
+        displacement_errors.last(),
+        displacement_errors.iter().copied().reduce(f64::max),
+    ) {
+        metrics.insert("displacement_error_final".into(), json!(last));
+        metrics.insert("displacement_error_max".into(), json!(max));
     }
     if let (Some(column), None) = (&setup.hydrostatic, &failure) {
         let stresses = sim.cauchy_stresses()?;
@@ -726,7 +768,7 @@ fn stage_seconds(times: &StageTimes) -> serde_json::Value {
 }
 
 /// Columns of `history.csv`.
-fn history_header(dimension: usize, with_reference: bool) -> Vec<String> {
+fn history_header(dimension: usize, with_reference: bool, with_displacement: bool) -> Vec<String> {
     let mut header: Vec<String> = ["step", "time", "kinetic", "elastic", "potential", "total"]
         .map(String::from)
         .into();
@@ -750,6 +792,9 @@ fn history_header(dimension: usize, with_reference: bool) -> Vec<String> {
     );
     if with_reference {
         header.push("velocity_error".into());
+    }
+    if with_displacement {
+        header.push("displacement_error".into());
     }
     header
 }
@@ -873,6 +918,29 @@ fn apply_boundaries<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) 
                         .fixed
                         .extend(vertices.iter().map(|(v, _)| *v)),
                     BoundaryKind::Slip => sim.boundary().slip.extend(vertices.iter().copied()),
+                }
+            }
+            BoundaryTarget::Region { region, normal } => {
+                let frame = &ctx.setup.frame;
+                let nodes: Vec<u32> = sim
+                    .node_positions()
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, x)| region.contains(&frame.point_to_scene(x)))
+                    .map(|(n, _)| n as u32)
+                    .collect();
+                if nodes.is_empty() {
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].region"),
+                        format!("holds no {} node", ctx.kernel.name()),
+                    ));
+                }
+                match normal {
+                    None => sim.boundary().fixed.extend(nodes),
+                    Some(n) => sim
+                        .boundary()
+                        .slip
+                        .extend(nodes.into_iter().map(|v| (v, *n))),
                 }
             }
         }

@@ -75,16 +75,22 @@ impl Scene {
 
     /// The bytes of the mesh file named in `[mesh] file`.
     pub fn mesh_bytes(&self, file: &str) -> Result<Vec<u8>> {
+        self.file_bytes("mesh.file", file)
+    }
+
+    /// The contents of a file the scene names at `key` (a mesh, reference data): beside
+    /// the scene file, or embedded for a built-in scene.
+    pub fn file_bytes(&self, key: &str, file: &str) -> Result<Vec<u8>> {
         match &self.base_dir {
-            None => crate::builtin::MESHES
+            None => crate::builtin::FILES
                 .iter()
                 .find(|(name, _)| *name == file)
                 .map(|(_, bytes)| bytes.to_vec())
-                .ok_or_else(|| self.value_error("mesh.file", format!("no embedded mesh `{file}`"))),
+                .ok_or_else(|| self.value_error(key, format!("no embedded file `{file}`"))),
             Some(dir) => {
                 let path = dir.join(file);
                 std::fs::read(&path).map_err(|source| {
-                    self.value_error("mesh.file", format!("{}: {source}", path.display()))
+                    self.value_error(key, format!("{}: {source}", path.display()))
                 })
             }
         }

@@ -37,6 +37,19 @@ pub struct SceneSpec {
     pub initial_stress: Option<InitialStressSpec>,
     /// A rotation of the whole scene into the world frame.
     pub transform: Option<TransformSpec>,
+    /// Named expressions the scene's fields may use as variables.
+    #[serde(default)]
+    pub definitions: std::collections::BTreeMap<String, String>,
+    /// A body acceleration field added to gravity.
+    pub body_force: Option<BodyForceSpec>,
+}
+
+/// `[body_force]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyForceSpec {
+    /// D components: acceleration b(x, t) at a particle's current position x.
+    pub acceleration: Vec<Component>,
 }
 
 /// `[transform]`: the scene as written is turned by `rotation` degrees (counter-clockwise
@@ -97,6 +110,9 @@ pub struct MeshSpec {
     pub file: Option<String>,
     /// A generated lattice mesh.
     pub lattice: Option<LatticeSpec>,
+    /// Turn the background mesh alone (not the bodies) before the run: a mesh at an
+    /// angle to the material it carries.
+    pub transform: Option<TransformSpec>,
     /// Reject (instead of fixing) negatively oriented cells of a file.
     #[serde(default)]
     pub reject_inverted: bool,
@@ -226,6 +242,9 @@ pub struct OutputSpec {
     pub frames: Option<usize>,
     /// Time between particle frames (instead of `frames`).
     pub interval: Option<f64>,
+    /// Points whose nearest particles are followed in `history.csv` (their displacement).
+    #[serde(default)]
+    pub probes: Vec<Vec<f64>>,
     /// Write diagnostics to `history.csv` every this many steps (default 1).
     #[serde(default = "default_history_every")]
     pub history_every: usize,
@@ -241,6 +260,7 @@ fn default_history_every() -> usize {
 impl Default for OutputSpec {
     fn default() -> Self {
         Self {
+            probes: Vec::new(),
             frames: None,
             interval: None,
             history_every: default_history_every(),
@@ -459,8 +479,15 @@ pub enum RegionSpec {
         /// Offset.
         offset: f64,
     },
-    /// The cells of a physical group of the mesh file (mesh seeding only).
+    /// The cells of a physical group of the mesh file (mesh seeding only, not inside a
+    /// combination).
     Group(String),
+    /// Points in all of these regions.
+    Intersection(Vec<RegionSpec>),
+    /// Points in any of these regions.
+    Union(Vec<RegionSpec>),
+    /// Points in the first region and in none of the others.
+    Difference(Vec<RegionSpec>),
 }
 
 /// How particles are placed.
@@ -469,6 +496,13 @@ pub enum RegionSpec {
 pub enum SeedingSpec {
     /// A regular lattice of this spacing over the mesh's bounding box.
     Lattice(f64),
+    /// A regular lattice anchored at a point, independent of the mesh.
+    LatticeFrom {
+        /// Spacing.
+        spacing: f64,
+        /// A corner of one lattice cell (its points are the cell centres).
+        origin: Vec<f64>,
+    },
     /// Quadrature points of the mesh cells.
     Mesh(QuadratureSpec),
 }
@@ -507,7 +541,8 @@ pub struct PlaneSpec {
     pub normal: Vec<f64>,
 }
 
-/// `[[boundaries]]`: nodes on a plane, or the vertices of a physical group.
+/// `[[boundaries]]`: nodes on a plane, the vertices of a physical group, or the nodes in
+/// a region.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoundarySpec {
@@ -517,10 +552,15 @@ pub struct BoundarySpec {
     pub plane: Option<PlaneSpec>,
     /// The vertices of this physical group (mesh kernels).
     pub group: Option<String>,
+    /// The kernel nodes inside this region (any kernel).
+    pub region: Option<RegionSpec>,
+    /// The wall normal of a slip condition on a region.
+    pub normal: Option<Vec<f64>>,
 }
 
-/// `[reference]`: an analytic velocity field v(X, t) at the particles' initial positions
-/// X, or the hydrostatic stress of a column at rest under gravity (at least one).
+/// `[reference]`: an analytic velocity field v(X, t) or displacement u(X, t) at the
+/// particles' initial positions X, or the hydrostatic stress of a column at rest under
+/// gravity (at least one).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReferenceSpec {
@@ -530,6 +570,21 @@ pub struct ReferenceSpec {
     pub scale: Option<f64>,
     /// The column's exact stress at the end of the run.
     pub hydrostatic: Option<HydrostaticSpec>,
+    /// D expressions in x, y, z (initial position) and t: the exact displacement.
+    pub displacement: Option<Vec<Component>>,
+    /// A stored displacement history of one of `[output] probes`.
+    pub probe: Option<ProbeReferenceSpec>,
+}
+
+/// `[reference.probe]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeReferenceSpec {
+    /// CSV file (relative to the scene file): a header line, then `time, u_x, u_y[, u_z]`.
+    pub file: String,
+    /// Index into `[output] probes` (default 0).
+    #[serde(default)]
+    pub probe: usize,
 }
 
 /// `[reference.hydrostatic]`: a laterally confined elastic column at rest under gravity.

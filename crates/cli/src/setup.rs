@@ -15,9 +15,10 @@ use umls_mesh::{Orientation, SampleRule, SimplexMesh};
 
 use crate::background::Background;
 use crate::error::{CliError, Result};
-use crate::expression::VectorField;
+use crate::expression::{Definitions, VectorField};
 use crate::frame::SceneFrame;
 use crate::hydrostatic::Hydrostatic;
+use crate::probes::ProbeReference;
 use crate::scene::Scene;
 use crate::schema::{
     BoundaryKind, DiagonalSpec, MaterialSpec, QuadratureSpec, RegionSpec, SeedingSpec, SolidSpec,
@@ -58,6 +59,14 @@ pub enum BoundaryTarget<const D: usize> {
     },
     /// These mesh vertices (with their outward normals, for slip).
     Vertices(Vec<(u32, SVector<f64, D>)>),
+    /// The kernel's nodes inside a region of the scene frame (a clamp that need not
+    /// conform to the mesh), with the wall normal of a slip condition (world frame).
+    Region {
+        /// The region, in the scene's own frame.
+        region: Region<D>,
+        /// Unit normal (slip only).
+        normal: Option<SVector<f64, D>>,
+    },
 }
 
 /// Everything a D-dimensional run needs besides the kernel, material and transfer types.
@@ -93,6 +102,12 @@ pub struct Setup<const D: usize> {
     pub reference: Option<(VectorField<D>, f64)>,
     /// The hydrostatic column's closed form (scene frame).
     pub hydrostatic: Option<Hydrostatic<D>>,
+    /// The exact displacement u(X, t) (scene frame).
+    pub displacement: Option<VectorField<D>>,
+    /// A stored displacement history of one probe (scene frame).
+    pub probe_reference: Option<ProbeReference<D>>,
+    /// The body acceleration b(x, t) (scene frame), added to gravity.
+    pub body_force: Option<VectorField<D>>,
     /// The rotation from the scene as written into the world it runs in; everything
     /// above except the references is already in the world frame.
     pub frame: SceneFrame<D>,
@@ -335,12 +350,60 @@ fn group<'a>(
     })
 }
 
+/// A region of the file (not a physical group) at `key`.
+pub(crate) fn region<const D: usize>(
+    scene: &Scene,
+    key: &str,
+    spec: &RegionSpec,
+) -> Result<Region<D>> {
+    let parts = |name: &str, list: &[RegionSpec]| -> Result<Vec<Region<D>>> {
+        if list.is_empty() {
+            return Err(scene.value_error(format!("{key}.{name}"), "lists no region"));
+        }
+        list.iter()
+            .enumerate()
+            .map(|(i, r)| region(scene, &format!("{key}.{name}[{i}]"), r))
+            .collect()
+    };
+    Ok(match spec {
+        RegionSpec::Everywhere(true) => Region::Everywhere,
+        RegionSpec::Everywhere(false) => {
+            return Err(scene.value_error(
+                format!("{key}.everywhere"),
+                "`false` selects nothing; omit the region instead",
+            ));
+        }
+        RegionSpec::Box { lower, upper } => Region::Box {
+            lower: vector(scene, &format!("{key}.box.lower"), lower)?,
+            upper: vector(scene, &format!("{key}.box.upper"), upper)?,
+        },
+        RegionSpec::Ball { centre, radius } => Region::Ball {
+            centre: vector(scene, &format!("{key}.ball.centre"), centre)?,
+            radius: *radius,
+        },
+        RegionSpec::HalfSpace { normal, offset } => Region::HalfSpace {
+            normal: vector(scene, &format!("{key}.half-space.normal"), normal)?,
+            offset: *offset,
+        },
+        RegionSpec::Group(_) => {
+            return Err(scene.value_error(
+                format!("{key}.group"),
+                "a physical group can only be a body's whole region",
+            ));
+        }
+        RegionSpec::Intersection(list) => Region::Intersection(parts("intersection", list)?),
+        RegionSpec::Union(list) => Region::Union(parts("union", list)?),
+        RegionSpec::Difference(list) => Region::Difference(parts("difference", list)?),
+    })
+}
+
 fn seed_body<const D: usize>(
     scene: &Scene,
     index: usize,
     background: &Background<D>,
     groups: &[PhysicalGroup],
     material: u16,
+    definitions: &Definitions,
     seeds: &mut Seeds<D>,
 ) -> Result<Option<String>> {
     let body = &scene.spec.bodies[index];
@@ -348,25 +411,7 @@ fn seed_body<const D: usize>(
     let density = scene.spec.materials[material as usize].density();
     let mut cells: Option<&[u32]> = None;
     let region: Region<D> = match &body.region {
-        None | Some(RegionSpec::Everywhere(true)) => Region::Everywhere,
-        Some(RegionSpec::Everywhere(false)) => {
-            return Err(scene.value_error(
-                key("region.everywhere"),
-                "`false` selects nothing; omit the region instead",
-            ));
-        }
-        Some(RegionSpec::Box { lower, upper }) => Region::Box {
-            lower: vector(scene, &key("region.box.lower"), lower)?,
-            upper: vector(scene, &key("region.box.upper"), upper)?,
-        },
-        Some(RegionSpec::Ball { centre, radius }) => Region::Ball {
-            centre: vector(scene, &key("region.ball.centre"), centre)?,
-            radius: *radius,
-        },
-        Some(RegionSpec::HalfSpace { normal, offset }) => Region::HalfSpace {
-            normal: vector(scene, &key("region.half-space.normal"), normal)?,
-            offset: *offset,
-        },
+        None => Region::Everywhere,
         Some(RegionSpec::Group(name)) => {
             let g = group(scene, groups, &key("region.group"), name)?;
             if g.dimension != D {
@@ -381,8 +426,40 @@ fn seed_body<const D: usize>(
             cells = Some(&g.cells);
             Region::Everywhere
         }
+        Some(spec) => region(scene, &key("region"), spec)?,
     };
     let samples: Vec<(SVector<f64, D>, f64)> = match &body.seeding {
+        SeedingSpec::LatticeFrom { spacing: h, origin } => {
+            if cells.is_some() {
+                return Err(scene.value_error(
+                    key("seeding"),
+                    "a group region needs mesh seeding (`centroid` or `gauss2`)",
+                ));
+            }
+            if !(h.is_finite() && *h > 0.0) {
+                return Err(
+                    scene.value_error(key("seeding.lattice-from.spacing"), "must be positive")
+                );
+            }
+            let origin: SVector<f64, D> =
+                vector(scene, &key("seeding.lattice-from.origin"), origin)?;
+            let (lower, upper) = background.bounding_box();
+            // Whole cells of the anchored lattice that meet the background's box.
+            let first = SVector::<f64, D>::from_fn(|k, _| ((lower[k] - origin[k]) / h).floor());
+            let last = SVector::<f64, D>::from_fn(|k, _| ((upper[k] - origin[k]) / h).ceil());
+            let count: f64 = (last - first).iter().product();
+            if count.is_nan() || count > MAX_LATTICE_POINTS {
+                return Err(scene.value_error(
+                    key("seeding.lattice-from.spacing"),
+                    format!("spacing {h} puts {count:.3e} lattice points over the mesh (limit {MAX_LATTICE_POINTS:.0e})"),
+                ));
+            }
+            let corner = origin + first * *h;
+            lattice_samples(corner, origin + last * *h, *h)
+                .into_iter()
+                .filter(|(x, _)| background.contains(x))
+                .collect()
+        }
         SeedingSpec::Lattice(h) => {
             if cells.is_some() {
                 return Err(scene.value_error(
@@ -438,7 +515,7 @@ fn seed_body<const D: usize>(
     let velocity = match &body.velocity {
         None => None,
         Some(components) => Some(
-            VectorField::<D>::compile(components, false)
+            VectorField::<D>::compile(components, false, definitions)
                 .map_err(|reason| scene.value_error(key("velocity"), reason))?,
         ),
     };
@@ -511,11 +588,34 @@ pub fn build_for<const D: usize>(
 ) -> Result<Setup<D>> {
     let spec = &scene.spec;
     let lean = grid_kernel
-        && spec
-            .bodies
-            .iter()
-            .all(|b| matches!(b.seeding, SeedingSpec::Lattice(_)));
-    let (background, lattice_spacing, groups) = background::<D>(scene, split, lean)?;
+        && spec.bodies.iter().all(|b| {
+            matches!(
+                b.seeding,
+                SeedingSpec::Lattice(_) | SeedingSpec::LatticeFrom { .. }
+            )
+        })
+        && spec.mesh.transform.is_none();
+    let (mut background, lattice_spacing, groups) = background::<D>(scene, split, lean)?;
+    if spec.mesh.transform.is_some() {
+        let turn =
+            SceneFrame::<D>::from_spec(scene, "mesh.transform", spec.mesh.transform.as_ref())?;
+        if let Background::Mesh(mesh) = &background {
+            background = Background::Mesh(Arc::new(
+                turn.mesh_to_world(mesh)
+                    .map_err(|e| scene.value_error("mesh.transform", e.to_string()))?,
+            ));
+        }
+    }
+    let definitions = Definitions::compile(&spec.definitions).map_err(|(name, reason)| {
+        scene.value_error(
+            if name.is_empty() {
+                "definitions".to_string()
+            } else {
+                format!("definitions.{name}")
+            },
+            reason,
+        )
+    })?;
     if spec.materials.is_empty() {
         return Err(scene.value_error("materials", "at least one material is needed"));
     }
@@ -555,13 +655,52 @@ pub fn build_for<const D: usize>(
             &background,
             &groups,
             material as u16,
+            &definitions,
             &mut seeds,
         )?);
     }
     let mut boundaries = Vec::new();
     for (i, b) in spec.boundaries.iter().enumerate() {
-        let target = match (&b.plane, &b.group) {
-            (Some(plane), None) => {
+        if b.normal.is_some() && b.region.is_none() {
+            return Err(scene.value_error(
+                format!("boundaries[{i}].normal"),
+                "only a `region` condition takes a normal (a plane has its own)",
+            ));
+        }
+        let target = match (&b.plane, &b.group, &b.region) {
+            (None, None, Some(spec)) => {
+                let normal = match (&b.normal, b.kind) {
+                    (None, BoundaryKind::Fixed) => None,
+                    (Some(n), BoundaryKind::Slip) => {
+                        let n: SVector<f64, D> =
+                            vector(scene, &format!("boundaries[{i}].normal"), n)?;
+                        if n.norm() == 0.0 {
+                            return Err(scene.value_error(
+                                format!("boundaries[{i}].normal"),
+                                "must not be zero",
+                            ));
+                        }
+                        Some(n.normalize())
+                    }
+                    (None, BoundaryKind::Slip) => {
+                        return Err(scene.value_error(
+                            format!("boundaries[{i}].normal"),
+                            "a slip condition on a region needs the wall's normal",
+                        ));
+                    }
+                    (Some(_), BoundaryKind::Fixed) => {
+                        return Err(scene.value_error(
+                            format!("boundaries[{i}].normal"),
+                            "a fixed condition takes no normal",
+                        ));
+                    }
+                };
+                BoundaryTarget::Region {
+                    region: region(scene, &format!("boundaries[{i}].region"), spec)?,
+                    normal,
+                }
+            }
+            (Some(plane), None, None) => {
                 let normal: SVector<f64, D> = vector(
                     scene,
                     &format!("boundaries[{i}].plane.normal"),
@@ -576,7 +715,7 @@ pub fn build_for<const D: usize>(
                     normal: normal.normalize(),
                 }
             }
-            (None, Some(name)) => {
+            (None, Some(name), None) => {
                 let g = group(scene, &groups, &format!("boundaries[{i}].group"), name)?;
                 let Some(mesh) = background.mesh() else {
                     return Err(scene.value_error(
@@ -594,7 +733,7 @@ pub fn build_for<const D: usize>(
             _ => {
                 return Err(scene.value_error(
                     format!("boundaries[{i}]"),
-                    "give exactly one of `plane` and `group`",
+                    "give exactly one of `plane`, `group` and `region`",
                 ));
             }
         };
@@ -645,7 +784,7 @@ pub fn build_for<const D: usize>(
     let reference = match spec.reference.as_ref().and_then(|r| r.velocity.as_ref()) {
         None => None,
         Some(velocity) => {
-            let field = VectorField::<D>::compile(velocity, true)
+            let field = VectorField::<D>::compile(velocity, true, &definitions)
                 .map_err(|reason| scene.value_error("reference.velocity", reason))?;
             let scale = match spec.reference.as_ref().and_then(|r| r.scale) {
                 Some(s) if s.is_finite() && s > 0.0 => s,
@@ -671,8 +810,16 @@ pub fn build_for<const D: usize>(
         }
     };
     let hydrostatic = match spec.reference.as_ref() {
-        Some(r) if r.velocity.is_none() && r.hydrostatic.is_none() => {
-            return Err(scene.value_error("reference", "give `velocity`, `hydrostatic`, or both"));
+        Some(r)
+            if r.velocity.is_none()
+                && r.hydrostatic.is_none()
+                && r.displacement.is_none()
+                && r.probe.is_none() =>
+        {
+            return Err(scene.value_error(
+                "reference",
+                "give at least one of `velocity`, `displacement`, `hydrostatic` and `probe`",
+            ));
         }
         Some(r) if r.velocity.is_none() && r.scale.is_some() => {
             return Err(scene.value_error(
@@ -686,8 +833,61 @@ pub fn build_for<const D: usize>(
         },
         None => None,
     };
+    let displacement = match spec
+        .reference
+        .as_ref()
+        .and_then(|r| r.displacement.as_ref())
+    {
+        None => None,
+        Some(u) => Some(
+            VectorField::<D>::compile(u, true, &definitions)
+                .map_err(|reason| scene.value_error("reference.displacement", reason))?,
+        ),
+    };
+    let body_force = match &spec.body_force {
+        None => None,
+        Some(b) => {
+            let field = VectorField::<D>::compile(&b.acceleration, true, &definitions)
+                .map_err(|reason| scene.value_error("body_force.acceleration", reason))?;
+            // A field that is not finite where the particles start would poison the run.
+            for x in &seeds.position {
+                let value = field
+                    .eval(x, 0.0)
+                    .map_err(|reason| scene.value_error("body_force.acceleration", reason))?;
+                if !value.iter().all(|c| c.is_finite()) {
+                    return Err(scene.value_error(
+                        "body_force.acceleration",
+                        format!("is not finite at the particle {:?} at t = 0", x.as_slice()),
+                    ));
+                }
+            }
+            Some(field)
+        }
+    };
+    let probe_reference = match spec.reference.as_ref().and_then(|r| r.probe.as_ref()) {
+        None => None,
+        Some(p) => {
+            let probes = spec.output.probes.len();
+            if p.probe >= probes {
+                return Err(scene.value_error(
+                    "reference.probe.probe",
+                    format!(
+                        "{} is not a probe (`output.probes` lists {probes})",
+                        p.probe
+                    ),
+                ));
+            }
+            let bytes = scene.file_bytes("reference.probe.file", &p.file)?;
+            let text = String::from_utf8_lossy(&bytes);
+            Some(ProbeReference::parse(
+                scene,
+                "reference.probe.file",
+                &text,
+                p.probe,
+            )?)
+        }
+    };
     let frame = SceneFrame::<D>::from_scene(scene)?;
-    let mut background = background;
     let mut gravity = gravity;
     if !frame.is_identity() {
         background = match background {
@@ -720,6 +920,11 @@ pub fn build_for<const D: usize>(
                         *normal = frame.vector_to_world(normal);
                     }
                 }
+                BoundaryTarget::Region { normal, .. } => {
+                    if let Some(n) = normal {
+                        *n = frame.vector_to_world(n);
+                    }
+                }
             }
         }
     }
@@ -739,6 +944,9 @@ pub fn build_for<const D: usize>(
         warnings,
         reference,
         hydrostatic,
+        displacement,
+        probe_reference,
+        body_force,
         frame,
     })
 }

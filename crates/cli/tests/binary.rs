@@ -516,7 +516,7 @@ fn an_interrupted_run_writes_its_output() {
     let mut child = Command::new(env!("CARGO_BIN_EXE_umls"))
         .args([
             "run",
-            "cantilever",
+            "steel-cantilever",
             "--end-time",
             "100",
             "--out",

@@ -174,6 +174,61 @@ fn unknown_keys_are_named() {
 fn bad_values_name_their_key() {
     for (scene, find, replace, key) in [
         (
+            "vortex",
+            "s = \"r - 1\"",
+            "s = \"h - 1\"",
+            "`definitions.h`",
+        ),
+        ("vortex", "b_r = \"-r", "b_r = \"q - r", "`definitions.b_r`"),
+        (
+            "vortex",
+            "acceleration = [\"(b_r",
+            "acceleration = [\"1 / 0 + (b_r",
+            "`body_force.acceleration`",
+        ),
+        (
+            "vortex",
+            "displacement = [\"x",
+            "displacement = [\"w + x",
+            "`reference.displacement`",
+        ),
+        (
+            "cantilever",
+            "kind = \"fixed\"",
+            "kind = \"slip\"",
+            "`boundaries[0].normal`",
+        ),
+        (
+            "cantilever",
+            "upper = [0.0, 10.0] } }",
+            "upper = [-9.0, -9.0] } }",
+            "`boundaries[0].region`",
+        ),
+        (
+            "cantilever",
+            "spacing = 0.125,",
+            "spacing = 0.0,",
+            "`bodies[0].seeding.lattice-from.spacing`",
+        ),
+        (
+            "cantilever",
+            "file = \"data/cantilever-tip.csv\"",
+            "file = \"data/cantilever-tip.csv\"\nprobe = 1",
+            "`reference.probe.probe`",
+        ),
+        (
+            "cantilever",
+            "file = \"data/cantilever-tip.csv\"",
+            "file = \"data/missing.csv\"",
+            "`reference.probe.file`",
+        ),
+        (
+            "cantilever",
+            "rotation = 0.0",
+            "rotation = 0.0\naxis = [0.0, 0.0, 1.0]",
+            "`mesh.transform.axis`",
+        ),
+        (
             "hydrostatic-column-tilted",
             "rotation = 30.0",
             "rotation = 30.0\naxis = [0.0, 0.0, 1.0]",
@@ -319,7 +374,7 @@ fn bad_values_name_their_key() {
             "`reference.scale`",
         ),
         (
-            "cantilever",
+            "steel-cantilever",
             "group = \"wall\"",
             "group = \"floor\"",
             "`boundaries[0].group`",
@@ -360,7 +415,7 @@ fn bad_values_name_their_key() {
 
 #[test]
 fn group_conditions_need_mesh_nodes() {
-    let scene = with("cantilever", "kind = \"umls\"", "kind = \"bspline2\"");
+    let scene = with("steel-cantilever", "kind = \"umls\"", "kind = \"bspline2\"");
     let err = run(&scene, &options("cantilever-bspline", Some(1e-3))).unwrap_err();
     assert!(
         matches!(&err, CliError::SceneValue { key, .. } if key == "boundaries[0].group"),

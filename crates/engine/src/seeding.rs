@@ -39,6 +39,10 @@ pub enum Region<const D: usize> {
     Predicate(Inside<D>),
     /// Points in all of the regions.
     Intersection(Vec<Region<D>>),
+    /// Points in any of the regions.
+    Union(Vec<Region<D>>),
+    /// Points in the first region and in none of the others.
+    Difference(Vec<Region<D>>),
 }
 
 impl<const D: usize> std::fmt::Debug for Region<D> {
@@ -53,7 +57,18 @@ impl<const D: usize> std::fmt::Debug for Region<D> {
                 write!(f, "HalfSpace({:?}, {offset})", normal.as_slice())
             }
             Region::Predicate(_) => write!(f, "Predicate"),
-            Region::Intersection(parts) => f.debug_list().entries(parts).finish(),
+            Region::Intersection(parts) => {
+                write!(f, "Intersection")?;
+                f.debug_list().entries(parts).finish()
+            }
+            Region::Union(parts) => {
+                write!(f, "Union")?;
+                f.debug_list().entries(parts).finish()
+            }
+            Region::Difference(parts) => {
+                write!(f, "Difference")?;
+                f.debug_list().entries(parts).finish()
+            }
         }
     }
 }
@@ -68,6 +83,11 @@ impl<const D: usize> Region<D> {
             Region::HalfSpace { normal, offset } => normal.dot(x) <= *offset,
             Region::Predicate(inside) => inside(x),
             Region::Intersection(parts) => parts.iter().all(|r| r.contains(x)),
+            Region::Union(parts) => parts.iter().any(|r| r.contains(x)),
+            Region::Difference(parts) => match parts.split_first() {
+                Some((first, rest)) => first.contains(x) && !rest.iter().any(|r| r.contains(x)),
+                None => false,
+            },
         }
     }
 }
@@ -127,5 +147,40 @@ impl<const D: usize, S: Clone, C: Copy + Default> Particles<D, S, C> {
         self.mass.extend(other.mass);
         self.state.extend(other.state);
         self.cache.extend(other.cache);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector2;
+
+    #[test]
+    fn combined_regions_are_the_set_operations() {
+        let ball = |r: f64| Region::Ball {
+            centre: Vector2::zeros(),
+            radius: r,
+        };
+        let annulus = Region::Difference(vec![ball(1.25), ball(0.75)]);
+        let right = Region::HalfSpace {
+            normal: Vector2::new(-1.0, 0.0),
+            offset: 0.0,
+        };
+        let half_annulus = Region::Intersection(vec![annulus.clone(), right]);
+        let either = Region::Union(vec![ball(0.5), half_annulus.clone()]);
+        for (x, y, in_annulus, in_half, in_either) in [
+            (1.0, 0.0, true, true, true),
+            (-1.0, 0.0, true, false, false),
+            (0.0, 0.0, false, false, true),
+            (0.0, 0.6, false, false, false),
+            (0.0, 1.3, false, false, false),
+        ] {
+            let p = Vector2::new(x, y);
+            assert_eq!(annulus.contains(&p), in_annulus, "{p}");
+            assert_eq!(half_annulus.contains(&p), in_half, "{p}");
+            assert_eq!(either.contains(&p), in_either, "{p}");
+        }
+        assert!(!Region::<2>::Difference(Vec::new()).contains(&Vector2::zeros()));
+        assert!(format!("{annulus:?}").starts_with("Difference[Ball"));
     }
 }
