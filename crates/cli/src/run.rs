@@ -366,7 +366,10 @@ trait Run<const D: usize> {
     fn set_geostatic_stress(&mut self, k0: f64) -> std::result::Result<(), EngineError>;
     fn spacing(&self) -> f64;
     /// Adds a wall; the number of nodes it constrains.
-    fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> usize;
+    /// Adds a wall; the nodes it constrains.
+    fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> Vec<u32>;
+    /// The constraint forces of the boundary's reaction sets in the last step.
+    fn reactions(&self) -> Vec<umls_engine::Reaction<D>>;
     fn boundary(&mut self) -> &mut Boundary<D>;
     fn positions(&self) -> &[SVector<f64, D>];
     fn velocities(&self) -> &[SVector<f64, D>];
@@ -410,8 +413,13 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
     fn spacing(&self) -> f64 {
         self.kernel.spacing()
     }
-    fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> usize {
-        self.boundary.add_wall(&self.kernel, wall, tolerance)
+    fn reactions(&self) -> Vec<umls_engine::Reaction<D>> {
+        Simulation::reactions(self).to_vec()
+    }
+    fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> Vec<u32> {
+        let nodes = Boundary::nodes_of_wall(&self.kernel, &wall, tolerance);
+        self.boundary.add_wall(&self.kernel, wall, tolerance);
+        nodes
     }
     fn boundary(&mut self) -> &mut Boundary<D> {
         &mut self.boundary
@@ -487,6 +495,14 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     let probes = Probes::new(scene, &setup.frame, &seeds.position)?;
     let mut header = history_header(D, setup.reference.is_some(), setup.displacement.is_some());
     header.extend(probes.columns(D));
+    for k in 0..setup.boundaries.len() {
+        header.extend(
+            ["x", "y", "z"][..D]
+                .iter()
+                .map(|a| format!("reaction{k}_{a}")),
+        );
+        header.push(format!("reaction{k}_magnitude"));
+    }
     let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut history = HistoryWriter::create(out.path("history.csv"), &header_refs)?;
 
@@ -513,6 +529,12 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         displacement_errors.extend(displacement);
         let mut row = history_row(&d, potential, total, error);
         row.extend(displacement);
+        let reactions = sim.reactions();
+        for k in 0..setup.boundaries.len() {
+            let r = reactions.get(k).copied().unwrap_or_default();
+            row.extend(r.force.iter());
+            row.push(r.magnitude);
+        }
         for k in 0..probes.len() {
             let u = probes.displacement(k, &setup.frame, &reference_positions, sim.positions());
             row.extend(u.iter());
@@ -898,12 +920,14 @@ fn apply_boundaries<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) 
                             "must not be zero",
                         )
                     })?;
-                if sim.add_wall(wall, tolerance) == 0 {
+                let nodes = sim.add_wall(wall, tolerance);
+                if nodes.is_empty() {
                     return Err(scene.value_error(
                         format!("boundaries[{i}].plane"),
                         format!("no {} node lies on or beyond the plane", ctx.kernel.name()),
                     ));
                 }
+                sim.boundary().reaction_sets.push(nodes);
             }
             BoundaryTarget::Vertices(vertices) => {
                 if !mesh_kernel {
@@ -919,6 +943,8 @@ fn apply_boundaries<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) 
                         .extend(vertices.iter().map(|(v, _)| *v)),
                     BoundaryKind::Slip => sim.boundary().slip.extend(vertices.iter().copied()),
                 }
+                let nodes = vertices.iter().map(|(v, _)| *v).collect();
+                sim.boundary().reaction_sets.push(nodes);
             }
             BoundaryTarget::Region { region, normal } => {
                 let frame = &ctx.setup.frame;
@@ -936,12 +962,10 @@ fn apply_boundaries<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) 
                     ));
                 }
                 match normal {
-                    None => sim.boundary().fixed.extend(nodes),
-                    Some(n) => sim
-                        .boundary()
-                        .slip
-                        .extend(nodes.into_iter().map(|v| (v, *n))),
+                    None => sim.boundary().fixed.extend(nodes.iter().copied()),
+                    Some(n) => sim.boundary().slip.extend(nodes.iter().map(|&v| (v, *n))),
                 }
+                sim.boundary().reaction_sets.push(nodes);
             }
         }
     }

@@ -95,6 +95,33 @@ fn bspline_column_settles_at_the_closed_form() {
         "{s}"
     );
     assert!((metric(s, "settlement_ratio") - 1.0).abs() < 0.07, "{s}");
+    // The walls' reactions at rest: the base carries the weight ρgHW = 40 kN, each side
+    // wall the lateral thrust K0 ρ g H² / 2 = 34.3 kN (per unit depth).
+    let text = std::fs::read_to_string(report.out.join("history.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let last: Vec<f64> = text
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let column = |name: &str| last[header.iter().position(|h| *h == name).unwrap()];
+    let weight = 1000.0 * 10.0 * 4.0;
+    assert!(
+        (column("reaction2_y") / weight - 1.0).abs() < 1e-3,
+        "{}",
+        column("reaction2_y")
+    );
+    let thrust = 0.3 / 0.7 * 1000.0 * 10.0 * 16.0 / 2.0;
+    assert!(
+        (column("reaction0_x") / thrust - 1.0).abs() < 0.05,
+        "{}",
+        column("reaction0_x")
+    );
+    // The two side walls push back equally (to round-off: the column is symmetric).
+    let (left, right) = (column("reaction0_x"), column("reaction1_x"));
+    assert!((left + right).abs() < 1e-9 * left, "{left} vs {right}");
 }
 
 /// A mesh kernel on the turned scene solves the same problem: with mass-proportional

@@ -90,6 +90,30 @@ pub struct Boundary<const D: usize> {
     pub separate: bool,
     /// Planar walls the particles may not cross (their nodes are in `fixed`/`slip`).
     pub walls: Vec<Wall<D>>,
+    /// Node sets whose reaction forces are summed each step (one per wall or group a
+    /// user wants to read; a node in two sets counts in both). See
+    /// [`crate::Simulation::reactions`].
+    pub reaction_sets: Vec<Vec<u32>>,
+}
+
+/// The force the constraints of one reaction set exert on the body in the last step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reaction<const D: usize> {
+    /// Σ (m_i v_i − p_i − Δt f_i) / Δt over the set's nodes: what the constraints added
+    /// to the nodal forces f_i (gravity and stress) to give the nodes' new momenta.
+    pub force: SVector<f64, D>,
+    /// The same sum of magnitudes: the total, which a closed wall pressed from
+    /// inside has although its vector sum vanishes (pressure × area for a slip wall).
+    pub magnitude: f64,
+}
+
+impl<const D: usize> Default for Reaction<D> {
+    fn default() -> Self {
+        Self {
+            force: SVector::zeros(),
+            magnitude: 0.0,
+        }
+    }
 }
 
 impl<const D: usize> Boundary<D> {

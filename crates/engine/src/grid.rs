@@ -71,6 +71,57 @@ pub(crate) struct GridUpdateReport<const D: usize> {
     pub scaled_nodes: usize,
 }
 
+/// The momenta the reaction sets' nodes would reach without constraints,
+/// p_i + Δt f_i, reused every step.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ReactionScratch<const D: usize> {
+    before: Vec<SVector<f64, D>>,
+}
+
+impl<const D: usize> ReactionScratch<D> {
+    /// Records p_i + Δt f_i of the reaction sets' nodes, before damping or constraints
+    /// touch the forces.
+    pub fn record(
+        &mut self,
+        boundary: &Boundary<D>,
+        momentum: &[SVector<f64, D>],
+        force: &[SVector<f64, D>],
+        dt: f64,
+    ) {
+        self.before.clear();
+        self.before.extend(
+            boundary
+                .reaction_sets
+                .iter()
+                .flatten()
+                .map(|&n| momentum[n as usize] + force[n as usize] * dt),
+        );
+    }
+
+    /// The reactions of the sets, from the velocities after the constraints.
+    pub fn reactions(
+        &self,
+        boundary: &Boundary<D>,
+        mass: &[f64],
+        velocity: &[SVector<f64, D>],
+        dt: f64,
+        out: &mut Vec<crate::boundary::Reaction<D>>,
+    ) {
+        out.clear();
+        let mut before = self.before.iter();
+        for set in &boundary.reaction_sets {
+            let mut r = crate::boundary::Reaction::default();
+            for (&n, free) in set.iter().zip(before.by_ref()) {
+                // The force the constraint added: (m v − (p + Δt f)) / Δt.
+                let impulse = (velocity[n as usize] * mass[n as usize] - free) / dt;
+                r.force += impulse;
+                r.magnitude += impulse.norm();
+            }
+            out.push(r);
+        }
+    }
+}
+
 impl<const D: usize> Grid<D> {
     /// Arrays for `nodes` nodes.
     pub fn new(nodes: usize, heaviest_particle: f64) -> Self {
@@ -101,6 +152,7 @@ impl<const D: usize> Grid<D> {
         cancellation_fraction: f64,
         damping: Damping,
         boundary: &Boundary<D>,
+        reactions: &mut (ReactionScratch<D>, Vec<crate::boundary::Reaction<D>>),
     ) -> GridUpdateReport<D> {
         let mut report = GridUpdateReport {
             dropped_mass: 0.0,
@@ -108,6 +160,11 @@ impl<const D: usize> Grid<D> {
             scaled_nodes: 0,
         };
         let mut active_mass = 0.0;
+        if !boundary.reaction_sets.is_empty() {
+            reactions
+                .0
+                .record(boundary, &self.momentum, &self.force, dt);
+        }
         if let Damping::Local { .. } = damping {
             // Local damping acts per component on the force the node is free to follow:
             // the part a wall takes (fixed, or normal to a slip wall) must not be damped,
@@ -168,6 +225,15 @@ impl<const D: usize> Grid<D> {
         }
         boundary.apply(&mut self.velocity);
         boundary.apply(&mut self.new_velocity);
+        if !boundary.reaction_sets.is_empty() {
+            reactions.0.reactions(
+                boundary,
+                &self.mass,
+                &self.new_velocity,
+                dt,
+                &mut reactions.1,
+            );
+        }
         report
     }
 }

@@ -57,7 +57,7 @@ mod stencils;
 mod timing;
 mod transfer;
 
-pub use boundary::{Boundary, Wall, WallKind};
+pub use boundary::{Boundary, Reaction, Wall, WallKind};
 pub use diagnostics::Diagnostics;
 pub use error::EngineError;
 pub use particles::Particles;

@@ -123,6 +123,11 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     // Per-particle buffers the step reuses, so a step allocates nothing once they have
     // grown to the particle count.
     stress_buffer: Vec<SMatrix<f64, D, D>>,
+    /// Scratch and results of the reaction sets' forces.
+    reactions: (
+        crate::grid::ReactionScratch<D>,
+        Vec<crate::boundary::Reaction<D>>,
+    ),
     updates: Vec<ParticleUpdate<D>>,
     velocity_gradients: Vec<SMatrix<f64, D, D>>,
 }
@@ -241,6 +246,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             blocks: Vec::new(),
             times: StageTimes::default(),
             stress_buffer: Vec::new(),
+            reactions: Default::default(),
             updates: Vec::new(),
             velocity_gradients: Vec::new(),
             grid,
@@ -310,6 +316,12 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     /// Nodal masses and velocities of the last step (after the grid update).
     pub fn grid(&self) -> (&[f64], &[SVector<f64, D>]) {
         (&self.grid.mass, &self.grid.new_velocity)
+    }
+
+    /// The forces the constraints of each of `boundary.reaction_sets` exerted on the
+    /// body in the last step (empty before the first step or without sets).
+    pub fn reactions(&self) -> &[crate::boundary::Reaction<D>] {
+        &self.reactions.1
     }
 
     /// Kirchhoff stress of every particle.
@@ -503,6 +515,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             self.settings.cancellation_fraction,
             self.settings.damping,
             &self.boundary,
+            &mut self.reactions,
         );
         self.totals.dropped_mass += report.dropped_mass;
         self.totals.redistributed_momentum += report.redistributed_momentum;
