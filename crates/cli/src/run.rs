@@ -529,12 +529,6 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         displacement_errors.extend(displacement);
         let mut row = history_row(&d, potential, total, error);
         row.extend(displacement);
-        let reactions = sim.reactions();
-        for k in 0..setup.boundaries.len() {
-            let r = reactions.get(k).copied().unwrap_or_default();
-            row.extend(r.force.iter());
-            row.push(r.magnitude);
-        }
         for k in 0..probes.len() {
             let u = probes.displacement(k, &setup.frame, &reference_positions, sim.positions());
             row.extend(u.iter());
@@ -543,6 +537,13 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
                     probe_error = probe_error.max((u - exact).norm() / reference.scale());
                 }
             }
+        }
+        // Reactions after the probes, as the header has them.
+        let reactions = sim.reactions();
+        for k in 0..setup.boundaries.len() {
+            let r = reactions.get(k).copied().unwrap_or_default();
+            row.extend(r.force.iter());
+            row.push(r.magnitude);
         }
         history.row(&row)?;
         let record = EnergyRecord {
@@ -929,13 +930,50 @@ fn apply_boundaries<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) 
                 }
                 sim.boundary().reaction_sets.push(nodes);
             }
-            BoundaryTarget::Vertices(vertices) => {
-                if !mesh_kernel {
+            BoundaryTarget::Vertices(vertices) if !mesh_kernel => {
+                // A grid sees the group as a staircase: its nodes outside the mesh near
+                // the group take the condition, with the nearest group vertex's normal.
+                let Some(mesh) = ctx.setup.background.mesh() else {
                     return Err(scene.value_error(
                         format!("boundaries[{i}].group"),
-                        format!("a group condition needs mesh nodes; the {} kernel uses a grid (use a plane)", ctx.kernel.name()),
+                        "a group condition needs the mesh it belongs to",
+                    ));
+                };
+                let reach = 3.0 * sim.spacing();
+                let nodes: Vec<(u32, SVector<f64, D>)> = sim
+                    .node_positions()
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, x)| mesh.locate(x).is_none())
+                    .filter_map(|(n, x)| {
+                        vertices
+                            .iter()
+                            .map(|(v, normal)| ((mesh.vertex(*v as usize) - x).norm(), normal))
+                            .min_by(|a, b| a.0.total_cmp(&b.0))
+                            .filter(|(d, _)| *d <= reach)
+                            .map(|(_, normal)| (n as u32, *normal))
+                    })
+                    .collect();
+                if nodes.is_empty() {
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].group"),
+                        format!(
+                            "no {} node lies outside the mesh near the group",
+                            ctx.kernel.name()
+                        ),
                     ));
                 }
+                match kind {
+                    BoundaryKind::Fixed => {
+                        sim.boundary().fixed.extend(nodes.iter().map(|(n, _)| *n))
+                    }
+                    BoundaryKind::Slip => sim.boundary().slip.extend(nodes.iter().copied()),
+                }
+                sim.boundary()
+                    .reaction_sets
+                    .push(nodes.iter().map(|(n, _)| *n).collect());
+            }
+            BoundaryTarget::Vertices(vertices) => {
                 match kind {
                     BoundaryKind::Fixed => sim
                         .boundary()
