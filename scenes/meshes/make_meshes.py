@@ -34,3 +34,38 @@ gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
 gmsh.option.setNumber("Mesh.Binary", 0)
 gmsh.write("cantilever-room.msh")
 gmsh.finalize()
+
+# sphere-container.msh: the spherical container of radius 1 of
+# `sphere-expansion-3d.toml`, tetrahedra of size 0.15; physical groups "wall" (the
+# sphere's surface) and "inside".
+gmsh.initialize()
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.model.add("sphere-container")
+ball = gmsh.model.occ.addSphere(0, 0, 0, 1.0)
+gmsh.model.occ.synchronize()
+gmsh.option.setNumber("Mesh.MeshSizeMin", 0.15)
+gmsh.option.setNumber("Mesh.MeshSizeMax", 0.15)
+surface = [c for _, c in gmsh.model.getBoundary([(3, ball)], oriented=False)]
+gmsh.model.addPhysicalGroup(2, surface, name="wall")
+gmsh.model.addPhysicalGroup(3, [ball], name="inside")
+gmsh.model.mesh.generate(3)
+gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+gmsh.option.setNumber("Mesh.Binary", 1)
+gmsh.write("sphere-container.msh")
+gmsh.finalize()
+
+# slope-box.msh: the box [0, 4] x [0, 0.4] x [0, 1.5] the slope of `slope-3d.toml`
+# collapses in, tetrahedra of size 0.13 (the walls are planes of the scene file).
+gmsh.initialize()
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.model.add("slope-box")
+box = gmsh.model.occ.addBox(0, 0, 0, 4.0, 0.4, 1.5)
+gmsh.model.occ.synchronize()
+gmsh.option.setNumber("Mesh.MeshSizeMin", 0.13)
+gmsh.option.setNumber("Mesh.MeshSizeMax", 0.13)
+gmsh.model.addPhysicalGroup(3, [box], name="box")
+gmsh.model.mesh.generate(3)
+gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+gmsh.option.setNumber("Mesh.Binary", 1)
+gmsh.write("slope-box.msh")
+gmsh.finalize()

@@ -13,7 +13,7 @@ pub struct Builtin {
 }
 
 /// Every built-in scene.
-pub const BUILTIN: [Builtin; 10] = [
+pub const BUILTIN: [Builtin; 12] = [
     Builtin {
         name: "colliding-disks",
         summary: "two elastic disks collide and rebound (Sulsky et al. 1994) on a jittered triangle mesh",
@@ -64,11 +64,21 @@ pub const BUILTIN: [Builtin; 10] = [
         summary: "generalized vortex manufactured solution: an annulus twisted by a body force, against the exact displacement",
         toml: include_str!("../../../scenes/vortex.toml"),
     },
+    Builtin {
+        name: "sphere-expansion-3d",
+        summary: "an elastic ball expands against a spherical container the mesh conforms to; wall pressure from reaction forces",
+        toml: include_str!("../../../scenes/sphere-expansion-3d.toml"),
+    },
+    Builtin {
+        name: "slope-3d",
+        summary: "a 45° Drucker–Prager slope collapses and runs out on a fixed floor (Gmsh tetrahedra)",
+        toml: include_str!("../../../scenes/slope-3d.toml"),
+    },
 ];
 
 /// Files the built-in scenes refer to (meshes, reference data), by the name the scene
 /// uses.
-pub const FILES: [(&str, &[u8]); 3] = [
+pub const FILES: [(&str, &[u8]); 5] = [
     (
         "meshes/cantilever.msh",
         include_bytes!("../../../scenes/meshes/cantilever.msh"),
@@ -76,6 +86,14 @@ pub const FILES: [(&str, &[u8]); 3] = [
     (
         "meshes/cantilever-room.msh",
         include_bytes!("../../../scenes/meshes/cantilever-room.msh"),
+    ),
+    (
+        "meshes/sphere-container.msh",
+        include_bytes!("../../../scenes/meshes/sphere-container.msh"),
+    ),
+    (
+        "meshes/slope-box.msh",
+        include_bytes!("../../../scenes/meshes/slope-box.msh"),
     ),
     (
         "data/cantilever-tip.csv",

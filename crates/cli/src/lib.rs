@@ -36,6 +36,7 @@ pub mod hydrostatic;
 pub mod mesh_info;
 mod output;
 pub mod plot;
+pub mod pressure;
 pub mod probes;
 mod progress;
 mod reference;

@@ -25,12 +25,14 @@ use umls_transfer::Kernel;
 use crate::error::{CliError, Result};
 use crate::output::OutputDir;
 use crate::plot::EnergyRecord;
+use crate::pressure::WallPressure;
 use crate::probes::Probes;
 use crate::progress::Progress;
 use crate::reference;
 use crate::scene::Scene;
 use crate::schema::{BoundaryKind, EncodingSpec, KernelKind, TransferKind};
 use crate::setup::{self, BoundaryTarget, Setup, Split};
+use umls_constitutive::Constitutive;
 use umls_constitutive::table::{
     MaterialTable, Model, NoPlasticity, PlasticModel, PlasticPart, TableState,
 };
@@ -370,6 +372,12 @@ trait Run<const D: usize> {
     fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> Vec<u32>;
     /// The constraint forces of the boundary's reaction sets in the last step.
     fn reactions(&self) -> Vec<umls_engine::Reaction<D>>;
+    /// Each reaction-set node's reaction, the sets one after the other.
+    fn node_reactions(&self) -> &[SVector<f64, D>];
+    /// The node sets whose reactions are summed.
+    fn reaction_sets(&mut self) -> Vec<Vec<u32>>;
+    /// Each material state scalar's name and its largest value over the particles.
+    fn state_scalar_maxima(&self) -> Vec<(&'static str, f64)>;
     fn boundary(&mut self) -> &mut Boundary<D>;
     fn positions(&self) -> &[SVector<f64, D>];
     fn velocities(&self) -> &[SVector<f64, D>];
@@ -415,6 +423,25 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
     }
     fn reactions(&self) -> Vec<umls_engine::Reaction<D>> {
         Simulation::reactions(self).to_vec()
+    }
+    fn node_reactions(&self) -> &[SVector<f64, D>] {
+        Simulation::node_reactions(self)
+    }
+    fn reaction_sets(&mut self) -> Vec<Vec<u32>> {
+        self.boundary.reaction_sets.clone()
+    }
+    fn state_scalar_maxima(&self) -> Vec<(&'static str, f64)> {
+        let names = self.material.state_scalar_names();
+        let mut maxima = vec![f64::NEG_INFINITY; names.len()];
+        let mut values = Vec::with_capacity(names.len());
+        for s in &self.particles.state {
+            values.clear();
+            self.material.state_scalars(s, &mut values);
+            for (m, v) in maxima.iter_mut().zip(&values) {
+                *m = m.max(*v);
+            }
+        }
+        names.iter().copied().zip(maxima).collect()
     }
     fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> Vec<u32> {
         let nodes = Boundary::nodes_of_wall(&self.kernel, &wall, tolerance);
@@ -493,6 +520,18 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
 
     let mut out = OutputDir::create(&ctx.options.out, ctx.encoding)?;
     let probes = Probes::new(scene, &setup.frame, &seeds.position)?;
+    // The measured wall: its nodes' positions, and where its reactions start among all
+    // reaction-set nodes.
+    let mut wall_pressure = setup.pressure.map(|(boundary, centre, area)| {
+        let sets = sim.reaction_sets();
+        let offset: usize = sets[..boundary].iter().map(Vec::len).sum();
+        let positions = sim.node_positions();
+        let nodes: Vec<SVector<f64, D>> = sets[boundary]
+            .iter()
+            .map(|&n| positions[n as usize])
+            .collect();
+        (WallPressure::new(boundary, centre, area), offset, nodes)
+    });
     let mut header = history_header(D, setup.reference.is_some(), setup.displacement.is_some());
     header.extend(probes.columns(D));
     for k in 0..setup.boundaries.len() {
@@ -536,6 +575,12 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
                 if let Some(exact) = reference.at(sim.time()) {
                     probe_error = probe_error.max((u - exact).norm() / reference.scale());
                 }
+            }
+        }
+        if let Some((wall, offset, nodes)) = wall_pressure.as_mut() {
+            let all = sim.node_reactions();
+            if all.len() >= *offset + nodes.len() {
+                wall.record(nodes, &all[*offset..*offset + nodes.len()]);
             }
         }
         // Reactions after the probes, as the header has them.
@@ -691,6 +736,40 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
             json!((error_sum / taken as f64).sqrt()),
         );
         metrics.insert("velocity_error_max".into(), json!(error_max));
+    }
+    for (name, max) in sim.state_scalar_maxima() {
+        metrics.insert(format!("max_{name}"), json!(max));
+    }
+    if let Some(direction) = &spec.output.front {
+        let d: SVector<f64, D> = setup::vector(scene, "output.front", direction)?;
+        if d.norm() == 0.0 {
+            return Err(scene.value_error("output.front", "must not be zero"));
+        }
+        let d = setup.frame.vector_to_world(&d.normalize());
+        let farthest = |xs: &[SVector<f64, D>]| {
+            xs.iter()
+                .map(|x| x.dot(&d))
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        metrics.insert(
+            "front_advance".into(),
+            json!(farthest(sim.positions()) - farthest(&reference_positions)),
+        );
+    }
+    if !probes.is_empty() {
+        let finals: Vec<Vec<f64>> = (0..probes.len())
+            .map(|k| {
+                probes
+                    .displacement(k, &setup.frame, &reference_positions, sim.positions())
+                    .iter()
+                    .copied()
+                    .collect()
+            })
+            .collect();
+        metrics.insert("probe_displacements".into(), json!(finals));
+    }
+    if let Some((wall, _, _)) = &wall_pressure {
+        metrics.extend(wall.metrics());
     }
     if setup.probe_reference.is_some() {
         metrics.insert("probe_error_max".into(), json!(probe_error));

@@ -245,6 +245,9 @@ pub struct OutputSpec {
     /// Points whose nearest particles are followed in `history.csv` (their displacement).
     #[serde(default)]
     pub probes: Vec<Vec<f64>>,
+    /// A direction (scene frame) along which the body's front advance is reported: the
+    /// farthest particle at the end against the farthest at the start (a run-out).
+    pub front: Option<Vec<f64>>,
     /// Write diagnostics to `history.csv` every this many steps (default 1).
     #[serde(default = "default_history_every")]
     pub history_every: usize,
@@ -261,6 +264,7 @@ impl Default for OutputSpec {
     fn default() -> Self {
         Self {
             probes: Vec::new(),
+            front: None,
             frames: None,
             interval: None,
             history_every: default_history_every(),
@@ -574,6 +578,20 @@ pub struct ReferenceSpec {
     pub displacement: Option<Vec<Component>>,
     /// A stored displacement history of one of `[output] probes`.
     pub probe: Option<ProbeReferenceSpec>,
+    /// The pressure on a closed wall, from its reaction forces.
+    pub pressure: Option<PressureSpec>,
+}
+
+/// `[reference.pressure]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PressureSpec {
+    /// Index into `[[boundaries]]` of the wall.
+    pub boundary: usize,
+    /// The point the wall is around (scene frame), for the angular bins.
+    pub centre: Vec<f64>,
+    /// The wall's area (length in 2D).
+    pub area: f64,
 }
 
 /// `[reference.probe]`.

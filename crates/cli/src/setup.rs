@@ -106,6 +106,8 @@ pub struct Setup<const D: usize> {
     pub displacement: Option<VectorField<D>>,
     /// A stored displacement history of one probe (scene frame).
     pub probe_reference: Option<ProbeReference<D>>,
+    /// The wall whose pressure is measured: boundary index, centre (world), area.
+    pub pressure: Option<(usize, SVector<f64, D>, f64)>,
     /// The body acceleration b(x, t) (scene frame), added to gravity.
     pub body_force: Option<VectorField<D>>,
     /// The rotation from the scene as written into the world it runs in; everything
@@ -814,11 +816,12 @@ pub fn build_for<const D: usize>(
             if r.velocity.is_none()
                 && r.hydrostatic.is_none()
                 && r.displacement.is_none()
-                && r.probe.is_none() =>
+                && r.probe.is_none()
+                && r.pressure.is_none() =>
         {
             return Err(scene.value_error(
                 "reference",
-                "give at least one of `velocity`, `displacement`, `hydrostatic` and `probe`",
+                "give at least one of `velocity`, `displacement`, `hydrostatic`, `probe` and `pressure`",
             ));
         }
         Some(r) if r.velocity.is_none() && r.scale.is_some() => {
@@ -888,6 +891,26 @@ pub fn build_for<const D: usize>(
         }
     };
     let frame = SceneFrame::<D>::from_scene(scene)?;
+    let pressure = match spec.reference.as_ref().and_then(|r| r.pressure.as_ref()) {
+        None => None,
+        Some(p) => {
+            if p.boundary >= spec.boundaries.len() {
+                return Err(scene.value_error(
+                    "reference.pressure.boundary",
+                    format!(
+                        "{} is not a boundary (`boundaries` lists {})",
+                        p.boundary,
+                        spec.boundaries.len()
+                    ),
+                ));
+            }
+            if !(p.area.is_finite() && p.area > 0.0) {
+                return Err(scene.value_error("reference.pressure.area", "must be positive"));
+            }
+            let centre: SVector<f64, D> = vector(scene, "reference.pressure.centre", &p.centre)?;
+            Some((p.boundary, frame.point_to_world(&centre), p.area))
+        }
+    };
     let mut gravity = gravity;
     if !frame.is_identity() {
         background = match background {
@@ -946,6 +969,7 @@ pub fn build_for<const D: usize>(
         hydrostatic,
         displacement,
         probe_reference,
+        pressure,
         body_force,
         frame,
     })

@@ -76,6 +76,8 @@ pub(crate) struct GridUpdateReport<const D: usize> {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct ReactionScratch<const D: usize> {
     before: Vec<SVector<f64, D>>,
+    /// Each set node's reaction in the last step, sets one after the other.
+    pub nodal: Vec<SVector<f64, D>>,
 }
 
 impl<const D: usize> ReactionScratch<D> {
@@ -100,7 +102,7 @@ impl<const D: usize> ReactionScratch<D> {
 
     /// The reactions of the sets, from the velocities after the constraints.
     pub fn reactions(
-        &self,
+        &mut self,
         boundary: &Boundary<D>,
         mass: &[f64],
         velocity: &[SVector<f64, D>],
@@ -108,12 +110,14 @@ impl<const D: usize> ReactionScratch<D> {
         out: &mut Vec<crate::boundary::Reaction<D>>,
     ) {
         out.clear();
+        self.nodal.clear();
         let mut before = self.before.iter();
         for set in &boundary.reaction_sets {
             let mut r = crate::boundary::Reaction::default();
             for (&n, free) in set.iter().zip(before.by_ref()) {
                 // The force the constraint added: (m v − (p + Δt f)) / Δt.
                 let impulse = (velocity[n as usize] * mass[n as usize] - free) / dt;
+                self.nodal.push(impulse);
                 r.force += impulse;
                 r.magnitude += impulse.norm();
             }

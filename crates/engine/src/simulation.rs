@@ -324,6 +324,12 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         &self.reactions.1
     }
 
+    /// Each reaction-set node's reaction in the last step, the sets one after the other
+    /// in the order of `boundary.reaction_sets` (empty before the first step).
+    pub fn node_reactions(&self) -> &[SVector<f64, D>] {
+        &self.reactions.0.nodal
+    }
+
     /// Kirchhoff stress of every particle.
     pub fn stresses(&self) -> Result<Vec<SMatrix<f64, D, D>>, EngineError> {
         let p = &self.particles;
