@@ -1,71 +1,68 @@
 """Regenerates the Gmsh meshes of the built-in scenes (needs `pip install gmsh`)."""
 import gmsh
 
-gmsh.initialize()
-gmsh.option.setNumber("General.Terminal", 0)
 
-# cantilever.msh: the room around a cantilever, [0, 2.4] x [-0.6, 0.4], unstructured
-# triangles of size 0.05; physical groups "wall" (the edge x = 0) and "room".
-gmsh.model.add("cantilever")
-r = gmsh.model.occ.addRectangle(0, -0.6, 0, 2.4, 1.0)
-gmsh.model.occ.synchronize()
-gmsh.model.mesh.setSize(gmsh.model.getEntities(0), 0.05)
-wall = [c for _, c in gmsh.model.getBoundary([(2, r)], oriented=False)
-        if abs(gmsh.model.occ.getCenterOfMass(1, c)[0]) < 1e-12]
-gmsh.model.addPhysicalGroup(1, wall, name="wall")
-gmsh.model.addPhysicalGroup(2, [r], name="room")
-gmsh.model.mesh.generate(2)
-gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
-gmsh.option.setNumber("Mesh.Binary", 0)
-gmsh.write("cantilever.msh")
-gmsh.finalize()
 
-# cantilever-room.msh: the square room [-3, 7] x [-6, 4] the 4 x 1 cantilever of
-# `cantilever-unstructured.toml` swings in, unstructured triangles of size 0.25 (the
-# structured scene's lattice spacing); no groups (the clamp is a region of nodes).
-gmsh.initialize()
-gmsh.option.setNumber("General.Terminal", 0)
-gmsh.model.add("cantilever-room")
-gmsh.model.occ.addRectangle(-3, -6, 0, 10, 10)
-gmsh.model.occ.synchronize()
-gmsh.model.mesh.setSize(gmsh.model.getEntities(0), 0.25)
-gmsh.model.mesh.generate(2)
-gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
-gmsh.option.setNumber("Mesh.Binary", 0)
-gmsh.write("cantilever-room.msh")
-gmsh.finalize()
+def mesh(name, build, binary=False):
+    """Builds one mesh with `build()` (geometry, sizes, groups) and writes NAME.msh."""
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.add(name)
+    build()
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.option.setNumber("Mesh.Binary", 1 if binary else 0)
+    gmsh.write(name + ".msh")
+    gmsh.finalize()
 
-# sphere-container.msh: the spherical container of radius 1 of
-# `sphere-expansion-3d.toml`, tetrahedra of size 0.15; physical groups "wall" (the
-# sphere's surface) and "inside".
-gmsh.initialize()
-gmsh.option.setNumber("General.Terminal", 0)
-gmsh.model.add("sphere-container")
-ball = gmsh.model.occ.addSphere(0, 0, 0, 1.0)
-gmsh.model.occ.synchronize()
-gmsh.option.setNumber("Mesh.MeshSizeMin", 0.15)
-gmsh.option.setNumber("Mesh.MeshSizeMax", 0.15)
-surface = [c for _, c in gmsh.model.getBoundary([(3, ball)], oriented=False)]
-gmsh.model.addPhysicalGroup(2, surface, name="wall")
-gmsh.model.addPhysicalGroup(3, [ball], name="inside")
-gmsh.model.mesh.generate(3)
-gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
-gmsh.option.setNumber("Mesh.Binary", 1)
-gmsh.write("sphere-container.msh")
-gmsh.finalize()
 
-# slope-box.msh: the box [0, 4] x [0, 0.4] x [0, 1.5] the slope of `slope-3d.toml`
-# collapses in, tetrahedra of size 0.13 (the walls are planes of the scene file).
-gmsh.initialize()
-gmsh.option.setNumber("General.Terminal", 0)
-gmsh.model.add("slope-box")
-box = gmsh.model.occ.addBox(0, 0, 0, 4.0, 0.4, 1.5)
-gmsh.model.occ.synchronize()
-gmsh.option.setNumber("Mesh.MeshSizeMin", 0.13)
-gmsh.option.setNumber("Mesh.MeshSizeMax", 0.13)
-gmsh.model.addPhysicalGroup(3, [box], name="box")
-gmsh.model.mesh.generate(3)
-gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
-gmsh.option.setNumber("Mesh.Binary", 1)
-gmsh.write("slope-box.msh")
-gmsh.finalize()
+def cantilever():
+    """The room around the steel cantilever, [0, 2.4] x [-0.6, 0.4], unstructured
+    triangles of size 0.05; physical groups "wall" (the edge x = 0) and "room"."""
+    r = gmsh.model.occ.addRectangle(0, -0.6, 0, 2.4, 1.0)
+    gmsh.model.occ.synchronize()
+    gmsh.model.mesh.setSize(gmsh.model.getEntities(0), 0.05)
+    wall = [c for _, c in gmsh.model.getBoundary([(2, r)], oriented=False)
+            if abs(gmsh.model.occ.getCenterOfMass(1, c)[0]) < 1e-12]
+    gmsh.model.addPhysicalGroup(1, wall, name="wall")
+    gmsh.model.addPhysicalGroup(2, [r], name="room")
+    gmsh.model.mesh.generate(2)
+
+
+def cantilever_room():
+    """The square room [-3, 7] x [-6, 4] the 4 x 1 cantilever of
+    `cantilever-unstructured.toml` swings in, unstructured triangles of size 0.25 (the
+    structured scene's lattice spacing); no groups (the clamp is a region of nodes)."""
+    gmsh.model.occ.addRectangle(-3, -6, 0, 10, 10)
+    gmsh.model.occ.synchronize()
+    gmsh.model.mesh.setSize(gmsh.model.getEntities(0), 0.25)
+    gmsh.model.mesh.generate(2)
+
+
+def sphere_container():
+    """The spherical container of radius 1 of `sphere-expansion-3d.toml`, tetrahedra of
+    size 0.15; physical groups "wall" (the sphere's surface) and "inside"."""
+    ball = gmsh.model.occ.addSphere(0, 0, 0, 1.0)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.15)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.15)
+    surface = [c for _, c in gmsh.model.getBoundary([(3, ball)], oriented=False)]
+    gmsh.model.addPhysicalGroup(2, surface, name="wall")
+    gmsh.model.addPhysicalGroup(3, [ball], name="inside")
+    gmsh.model.mesh.generate(3)
+
+
+def slope_box():
+    """The box [0, 4] x [0, 0.4] x [0, 1.5] the slope of `slope-3d.toml` collapses in,
+    tetrahedra of size 0.13 (the walls are planes of the scene file)."""
+    box = gmsh.model.occ.addBox(0, 0, 0, 4.0, 0.4, 1.5)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.13)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.13)
+    gmsh.model.addPhysicalGroup(3, [box], name="box")
+    gmsh.model.mesh.generate(3)
+
+
+mesh("cantilever", cantilever)
+mesh("cantilever-room", cantilever_room)
+mesh("sphere-container", sphere_container, binary=True)
+mesh("slope-box", slope_box, binary=True)

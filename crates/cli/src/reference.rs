@@ -5,6 +5,7 @@
 use nalgebra::SVector;
 
 use crate::error::Result;
+use crate::expression::VectorField;
 use crate::scene::Scene;
 use crate::setup::Setup;
 
@@ -20,16 +21,16 @@ pub fn velocity_error<const D: usize>(
     let Some((field, scale)) = &setup.reference else {
         return Ok(None);
     };
-    let frame = &setup.frame;
-    let mut sum = 0.0;
-    for (v, x0) in velocities.iter().zip(initial) {
-        let exact = field
-            .eval(&frame.point_to_scene(x0), time)
-            .map(|v| frame.vector_to_world(&v))
-            .map_err(|reason| scene.value_error("reference.velocity", reason))?;
-        sum += (v - exact).norm_squared();
-    }
-    Ok(Some((sum / initial.len().max(1) as f64).sqrt() / scale))
+    let rms = rms_error(
+        scene,
+        "reference.velocity",
+        setup,
+        field,
+        initial,
+        time,
+        |i| velocities[i],
+    )?;
+    Ok(Some(rms / scale))
 }
 
 /// RMS over particles of |x − X − u_ref(X, t)| (a length: the displacement has no
@@ -44,14 +45,37 @@ pub fn displacement_error<const D: usize>(
     let Some(field) = &setup.displacement else {
         return Ok(None);
     };
+    rms_error(
+        scene,
+        "reference.displacement",
+        setup,
+        field,
+        initial,
+        time,
+        |i| positions[i] - initial[i],
+    )
+    .map(Some)
+}
+
+/// RMS over particles of |computed(i) − field(X_i, t)|, the field evaluated in the
+/// scene frame and turned into the world.
+fn rms_error<const D: usize>(
+    scene: &Scene,
+    key: &str,
+    setup: &Setup<D>,
+    field: &VectorField<D>,
+    initial: &[SVector<f64, D>],
+    time: f64,
+    computed: impl Fn(usize) -> SVector<f64, D>,
+) -> Result<f64> {
     let frame = &setup.frame;
     let mut sum = 0.0;
-    for (x, x0) in positions.iter().zip(initial) {
+    for (i, x0) in initial.iter().enumerate() {
         let exact = field
             .eval(&frame.point_to_scene(x0), time)
-            .map(|u| frame.vector_to_world(&u))
-            .map_err(|reason| scene.value_error("reference.displacement", reason))?;
-        sum += (x - x0 - exact).norm_squared();
+            .map(|v| frame.vector_to_world(&v))
+            .map_err(|reason| scene.value_error(key, reason))?;
+        sum += (computed(i) - exact).norm_squared();
     }
-    Ok(Some((sum / initial.len().max(1) as f64).sqrt()))
+    Ok((sum / initial.len().max(1) as f64).sqrt())
 }

@@ -1,9 +1,13 @@
 //! The `fluid-box-3d` scene (Taichi's mpm3d) and the grid kernels' lean background: a
 //! B-spline run of a `[mesh.lattice]` scene never splits the lattice into simplices.
 
-use umls_cli::run::{RunOptions, run};
+use umls_cli::run::run;
 use umls_cli::scene::Scene;
 use umls_cli::setup::{build, build_for, tetrahedra, triangles};
+
+#[path = "common/runs.rs"]
+mod runs;
+use runs::{History, options};
 
 /// The first 25 steps: the block is in free fall (it is 0.1 above the floor plane), so
 /// its momentum is −M g t along y to round-off and nothing else moves it; no mesh is
@@ -11,16 +15,9 @@ use umls_cli::setup::{build, build_for, tetrahedra, triangles};
 #[test]
 fn fluid_box_falls_freely_at_first_without_a_mesh() {
     let scene = Scene::load("fluid-box-3d").unwrap();
-    let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("fluid-box");
-    let options = RunOptions {
-        kernel: None,
-        out: out.clone(),
-        end_time: Some(0.005),
-        threads: Some(2),
-        progress: false,
-        interrupt: None,
-    };
+    let options = options("fluid-box", None, Some(0.005));
     let report = run(&scene, &options).unwrap();
+    let out = options.out.clone();
     let s = &report.summary;
     assert_eq!(s["kernel"], "bspline2");
     assert_eq!(s["particles"], 64_000);
@@ -30,16 +27,8 @@ fn fluid_box_falls_freely_at_first_without_a_mesh() {
         "{s}"
     );
     assert!(!out.join("mesh.vtu").exists() && out.join("grid.vtu").exists());
-    let text = std::fs::read_to_string(out.join("history.csv")).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let last: Vec<f64> = text
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .map(|v| v.parse().unwrap())
-        .collect();
-    let column = |name: &str| last[header.iter().position(|h| *h == name).unwrap()];
+    let history = History::read(&out);
+    let column = |name: &str| history.last(name);
     // 64,000 particles of 10⁻⁶ m³ at density 1 (a sum of 64,000 rounded volumes).
     let mass = column("mass");
     assert!((mass - 0.064).abs() < 1e-12 * 0.064, "{mass}");

@@ -1,41 +1,13 @@
 //! The hydrostatic-column scenes: their metrics against the closed form, the metrics
 //! themselves against an exactly known state, and a turned scene against the upright one.
 
-use umls_cli::run::{RunOptions, run};
+use umls_cli::run::run;
 use umls_cli::scene::Scene;
 use umls_cli::schema::KernelKind;
 
-fn options(name: &str, kernel: KernelKind, end_time: Option<f64>) -> RunOptions {
-    RunOptions {
-        kernel: Some(kernel),
-        out: std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name),
-        end_time,
-        threads: Some(2),
-        progress: false,
-        interrupt: None,
-    }
-}
-
-fn metric(summary: &serde_json::Value, name: &str) -> f64 {
-    summary["metrics"][name]
-        .as_f64()
-        .unwrap_or_else(|| panic!("no metric `{name}` in {summary}"))
-}
-
-/// The builtin scene with `find` replaced by `replace` (which must occur).
-fn variant(name: &str, find: &str, replace: &str) -> Scene {
-    let builtin = umls_cli::builtin::BUILTIN
-        .iter()
-        .find(|b| b.name == name)
-        .unwrap();
-    assert!(builtin.toml.contains(find), "{find}");
-    Scene::parse(
-        &builtin.toml.replacen(find, replace, 1),
-        "variant.toml",
-        None,
-    )
-    .unwrap()
-}
+#[path = "common/runs.rs"]
+mod runs;
+use runs::{History, metric, options, variant};
 
 /// Particles that start at the geostatic stress of the exact solution: one short step
 /// later every stress metric reads the closed form, in the upright scene and in the
@@ -48,17 +20,18 @@ fn metrics_read_the_exact_state_as_exact() {
         "hydrostatic-column-tilted",
         "hydrostatic-column-3d",
     ] {
-        let scene = variant(
-            name,
-            "[damping]",
-            &format!(
-                "[initial_stress]\ngeostatic_k0 = {}\n\n[damping]",
-                0.3 / 0.7
-            ),
+        let stress = format!(
+            "[initial_stress]\ngeostatic_k0 = {}\n\n[damping]",
+            0.3 / 0.7
         );
+        let scene = variant(name, &[("[damping]", &stress)]);
         let report = run(
             &scene,
-            &options(&format!("{name}-exact"), KernelKind::Bspline2, Some(1e-9)),
+            &options(
+                &format!("{name}-exact"),
+                Some(KernelKind::Bspline2),
+                Some(1e-9),
+            ),
         )
         .unwrap();
         let s = &report.summary;
@@ -84,7 +57,7 @@ fn bspline_column_settles_at_the_closed_form() {
     let scene = Scene::load("hydrostatic-column").unwrap();
     let report = run(
         &scene,
-        &options("column-bspline2", KernelKind::Bspline2, None),
+        &options("column-bspline2", Some(KernelKind::Bspline2), None),
     )
     .unwrap();
     let s = &report.summary;
@@ -97,16 +70,8 @@ fn bspline_column_settles_at_the_closed_form() {
     assert!((metric(s, "settlement_ratio") - 1.0).abs() < 0.07, "{s}");
     // The walls' reactions at rest: the base carries the weight ρgHW = 40 kN, each side
     // wall the lateral thrust K0 ρ g H² / 2 = 34.3 kN (per unit depth).
-    let text = std::fs::read_to_string(report.out.join("history.csv")).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let last: Vec<f64> = text
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .map(|v| v.parse().unwrap())
-        .collect();
-    let column = |name: &str| last[header.iter().position(|h| *h == name).unwrap()];
+    let history = History::read(&report.out);
+    let column = |name: &str| history.last(name);
     let weight = 1000.0 * 10.0 * 4.0;
     assert!(
         (column("reaction2_y") / weight - 1.0).abs() < 1e-3,
@@ -132,17 +97,20 @@ fn bspline_column_settles_at_the_closed_form() {
 #[test]
 fn turned_column_on_its_mesh_is_the_upright_column() {
     let metrics = |scene: &Scene, name: &str| {
-        let report = run(scene, &options(name, KernelKind::LinearFe, None)).unwrap();
+        let report = run(scene, &options(name, Some(KernelKind::LinearFe), None)).unwrap();
         report.summary["metrics"].clone()
     };
     let keys = ["stress_rms", "bottom_row_ratio", "k0", "settlement_ratio"];
     let mass = "[damping]\nmass = 100.0";
     let upright = metrics(
-        &variant("hydrostatic-column", "[damping]\nlocal = 0.5", mass),
+        &variant("hydrostatic-column", &[("[damping]\nlocal = 0.5", mass)]),
         "column-upright",
     );
     let turned = metrics(
-        &variant("hydrostatic-column-tilted", "[damping]\nlocal = 0.5", mass),
+        &variant(
+            "hydrostatic-column-tilted",
+            &[("[damping]\nlocal = 0.5", mass)],
+        ),
         "column-turned",
     );
     for key in keys {

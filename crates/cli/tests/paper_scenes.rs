@@ -2,42 +2,14 @@
 //! combined regions; a mesh turned under its particles, a clamp of nodes in a region,
 //! probes and a stored reference history.
 
-use umls_cli::run::{RunOptions, run};
+use umls_cli::run::run;
 use umls_cli::scene::Scene;
 use umls_cli::schema::KernelKind;
 use umls_cli::setup::{build, triangles};
 
-fn options(name: &str, kernel: KernelKind, end_time: Option<f64>) -> RunOptions {
-    RunOptions {
-        kernel: Some(kernel),
-        out: std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name),
-        end_time,
-        threads: Some(2),
-        progress: false,
-        interrupt: None,
-    }
-}
-
-fn metric(summary: &serde_json::Value, name: &str) -> f64 {
-    summary["metrics"][name]
-        .as_f64()
-        .unwrap_or_else(|| panic!("no metric `{name}` in {summary}"))
-}
-
-/// The builtin scene with each `find` replaced by its `replace` (which must occur).
-fn variant(name: &str, edits: &[(&str, &str)]) -> Scene {
-    let mut text = umls_cli::builtin::BUILTIN
-        .iter()
-        .find(|b| b.name == name)
-        .unwrap()
-        .toml
-        .to_string();
-    for (find, replace) in edits {
-        assert!(text.contains(find), "{find}");
-        text = text.replacen(find, replace, 1);
-    }
-    Scene::parse(&text, "variant.toml", None).unwrap()
-}
+#[path = "common/runs.rs"]
+mod runs;
+use runs::{History, metric, options, variant};
 
 /// The annulus is a difference of balls; its lattice particles fill its area.
 #[test]
@@ -58,7 +30,7 @@ fn vortex_seeds_the_annulus() {
 fn vortex_converges_with_umls() {
     let coarse = run(
         &Scene::load("vortex").unwrap(),
-        &options("vortex-30", KernelKind::Umls, None),
+        &options("vortex-30", Some(KernelKind::Umls), None),
     )
     .unwrap();
     let fine_scene = variant(
@@ -68,7 +40,11 @@ fn vortex_converges_with_umls() {
             ("lattice = 0.05 }", "lattice = 0.025 }"),
         ],
     );
-    let fine = run(&fine_scene, &options("vortex-60", KernelKind::Umls, None)).unwrap();
+    let fine = run(
+        &fine_scene,
+        &options("vortex-60", Some(KernelKind::Umls), None),
+    )
+    .unwrap();
     let (e1, e2) = (
         metric(&coarse.summary, "displacement_error_max"),
         metric(&fine.summary, "displacement_error_max"),
@@ -90,7 +66,7 @@ fn a_run_that_inverts_a_particle_still_writes_its_summary() {
             ("lattice = 0.05 }", "lattice = 0.025 }"),
         ],
     );
-    let options = options("inverted", KernelKind::LinearFe, None);
+    let options = options("inverted", Some(KernelKind::LinearFe), None);
     let err = run(&scene, &options).unwrap_err();
     assert!(err.to_string().contains("det F"), "{err}");
     let text = std::fs::read_to_string(options.out.join("summary.json")).unwrap();
@@ -138,18 +114,10 @@ fn cantilever_clamp_holds_and_the_tip_follows_the_reference() {
         )],
     );
     for kernel in [KernelKind::Bspline2, KernelKind::LinearFe] {
-        let out = options(&format!("cantilever-{kernel:?}"), kernel, Some(0.3));
+        let out = options(&format!("cantilever-{kernel:?}"), Some(kernel), Some(0.3));
         let report = run(&scene, &out).unwrap();
-        let text = std::fs::read_to_string(out.out.join("history.csv")).unwrap();
-        let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-        let last: Vec<f64> = text
-            .lines()
-            .last()
-            .unwrap()
-            .split(',')
-            .map(|v| v.parse().unwrap())
-            .collect();
-        let column = |name: &str| last[header.iter().position(|h| *h == name).unwrap()];
+        let history = History::read(&out.out);
+        let column = |name: &str| history.last(name);
         assert!(
             column("probe0_uy") < -0.1,
             "{kernel:?}: the tip fell {}",
@@ -175,7 +143,7 @@ fn cantilever_clamp_holds_and_the_tip_follows_the_reference() {
 #[test]
 fn expanding_ball_presses_evenly_on_the_curved_wall() {
     for kernel in [KernelKind::LinearFe, KernelKind::Umls, KernelKind::Bspline2] {
-        let out = options(&format!("sphere-{kernel:?}"), kernel, Some(0.05));
+        let out = options(&format!("sphere-{kernel:?}"), Some(kernel), Some(0.05));
         let report = run(&Scene::load("sphere-expansion-3d").unwrap(), &out).unwrap();
         let s = &report.summary;
         assert!(
@@ -212,7 +180,7 @@ fn expanding_ball_presses_evenly_on_the_curved_wall() {
 #[test]
 fn slope_starts_to_slide_with_both_kernels() {
     for kernel in [KernelKind::Umls, KernelKind::Bspline2] {
-        let out = options(&format!("slope-{kernel:?}"), kernel, Some(0.1));
+        let out = options(&format!("slope-{kernel:?}"), Some(kernel), Some(0.1));
         let report = run(&Scene::load("slope-3d").unwrap(), &out).unwrap();
         let s = &report.summary;
         let crest = s["metrics"]["probe_displacements"][0][2].as_f64().unwrap();
