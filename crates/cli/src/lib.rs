@@ -29,6 +29,8 @@
 
 pub mod background;
 pub mod builtin;
+mod conditions;
+mod end_metrics;
 mod error;
 pub mod expression;
 pub mod frame;

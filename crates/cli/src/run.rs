@@ -14,7 +14,7 @@ use nalgebra::{SMatrix, SVector};
 use serde_json::json;
 use umls_engine::{
     Apic, Boundary, Diagnostics, EngineError, Flip, Particles, Simulation, StageTimes,
-    StepSettings, TimeStepControl, TransferScheme, VelocityGradientAffine, Wall, WallKind,
+    StepSettings, TimeStepControl, TransferScheme, VelocityGradientAffine, Wall,
 };
 use umls_io::csv::HistoryWriter;
 use umls_io::vtk::Encoding;
@@ -30,8 +30,9 @@ use crate::probes::Probes;
 use crate::progress::Progress;
 use crate::reference;
 use crate::scene::Scene;
-use crate::schema::{BoundaryKind, EncodingSpec, KernelKind, TransferKind};
-use crate::setup::{self, BoundaryTarget, Setup, Split};
+use crate::schema::{EncodingSpec, KernelKind, TransferKind};
+use crate::setup::{self, Setup, Split};
+use crate::{conditions, end_metrics};
 use umls_constitutive::Constitutive;
 use umls_constitutive::table::{
     MaterialTable, Model, NoPlasticity, PlasticModel, PlasticPart, TableState,
@@ -123,13 +124,13 @@ impl Dimension<3> for D3 {
 }
 
 /// Everything the typed part of a run reads.
-struct Context<'a, const D: usize> {
-    scene: &'a Scene,
-    setup: Setup<D>,
-    options: &'a RunOptions,
-    kernel: KernelKind,
-    end_time: f64,
-    encoding: Encoding,
+pub(crate) struct Context<'a, const D: usize> {
+    pub(crate) scene: &'a Scene,
+    pub(crate) setup: Setup<D>,
+    pub(crate) options: &'a RunOptions,
+    pub(crate) kernel: KernelKind,
+    pub(crate) end_time: f64,
+    pub(crate) encoding: Encoding,
 }
 
 /// Runs `scene` with `options`.
@@ -357,7 +358,7 @@ fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
 /// What the run loop needs of a simulation. Object-safe, so [`drive`] is compiled once
 /// per dimension; only [`Run::step`] and the output of particle fields are compiled for
 /// each kernel, material table and transfer, which is where the time goes.
-trait Run<const D: usize> {
+pub(crate) trait Run<const D: usize> {
     fn step(&mut self) -> std::result::Result<(), EngineError>;
     fn time(&self) -> f64;
     fn step_count(&self) -> usize;
@@ -513,7 +514,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     let stable_dt = sim.stable_time_step(1.0);
     let (steps, dt_cap) = plan_time_step(ctx, sim, stable_dt, &mut warnings)?;
     let mesh_kernel = matches!(ctx.kernel, KernelKind::Umls | KernelKind::LinearFe);
-    apply_boundaries(ctx, sim)?;
+    conditions::apply_boundaries(ctx, sim)?;
     for w in &warnings {
         eprintln!("warning: {w}");
     }
@@ -737,37 +738,14 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         );
         metrics.insert("velocity_error_max".into(), json!(error_max));
     }
-    for (name, max) in sim.state_scalar_maxima() {
-        metrics.insert(format!("max_{name}"), json!(max));
-    }
-    if let Some(direction) = &spec.output.front {
-        let d: SVector<f64, D> = setup::vector(scene, "output.front", direction)?;
-        if d.norm() == 0.0 {
-            return Err(scene.value_error("output.front", "must not be zero"));
-        }
-        let d = setup.frame.vector_to_world(&d.normalize());
-        let farthest = |xs: &[SVector<f64, D>]| {
-            xs.iter()
-                .map(|x| x.dot(&d))
-                .fold(f64::NEG_INFINITY, f64::max)
-        };
-        metrics.insert(
-            "front_advance".into(),
-            json!(farthest(sim.positions()) - farthest(&reference_positions)),
-        );
-    }
-    if !probes.is_empty() {
-        let finals: Vec<Vec<f64>> = (0..probes.len())
-            .map(|k| {
-                probes
-                    .displacement(k, &setup.frame, &reference_positions, sim.positions())
-                    .iter()
-                    .copied()
-                    .collect()
-            })
-            .collect();
-        metrics.insert("probe_displacements".into(), json!(finals));
-    }
+    metrics.extend(end_metrics::end_state(
+        scene,
+        setup,
+        &*sim,
+        &reference_positions,
+        &probes,
+        failure.is_some(),
+    )?);
     if let Some((wall, _, _)) = &wall_pressure {
         metrics.extend(wall.metrics());
     }
@@ -780,15 +758,6 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     ) {
         metrics.insert("displacement_error_final".into(), json!(last));
         metrics.insert("displacement_error_max".into(), json!(max));
-    }
-    if let (Some(column), None) = (&setup.hydrostatic, &failure) {
-        let stresses = sim.cauchy_stresses()?;
-        metrics.extend(column.metrics(
-            &setup.frame,
-            &reference_positions,
-            sim.positions(),
-            &stresses,
-        ));
     }
     let summary = json!({
         "scene": spec.scene.name,
@@ -979,114 +948,6 @@ fn plan_time_step<const D: usize>(
     }
 
     Ok((steps, dt_cap))
-}
-
-/// Walls on planes, and fixed or slip conditions on the nodes of mesh groups.
-fn apply_boundaries<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<()> {
-    let scene = ctx.scene;
-    let mesh_kernel = matches!(ctx.kernel, KernelKind::Umls | KernelKind::LinearFe);
-    for (i, (kind, target)) in ctx.setup.boundaries.iter().enumerate() {
-        let wall_kind = match kind {
-            BoundaryKind::Fixed => WallKind::Fixed,
-            BoundaryKind::Slip => WallKind::Slip,
-        };
-        match target {
-            BoundaryTarget::Plane { point, normal } => {
-                let tolerance = 1e-6 * sim.spacing();
-                let wall =
-                    Wall::facing(wall_kind, *point, *normal, sim.positions()).ok_or_else(|| {
-                        scene.value_error(
-                            format!("boundaries[{i}].plane.normal"),
-                            "must not be zero",
-                        )
-                    })?;
-                let nodes = sim.add_wall(wall, tolerance);
-                if nodes.is_empty() {
-                    return Err(scene.value_error(
-                        format!("boundaries[{i}].plane"),
-                        format!("no {} node lies on or beyond the plane", ctx.kernel.name()),
-                    ));
-                }
-                sim.boundary().reaction_sets.push(nodes);
-            }
-            BoundaryTarget::Vertices(vertices) if !mesh_kernel => {
-                // A grid sees the group as a staircase: its nodes outside the mesh near
-                // the group take the condition, with the nearest group vertex's normal.
-                let Some(mesh) = ctx.setup.background.mesh() else {
-                    return Err(scene.value_error(
-                        format!("boundaries[{i}].group"),
-                        "a group condition needs the mesh it belongs to",
-                    ));
-                };
-                let reach = 3.0 * sim.spacing();
-                let nodes: Vec<(u32, SVector<f64, D>)> = sim
-                    .node_positions()
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, x)| mesh.locate(x).is_none())
-                    .filter_map(|(n, x)| {
-                        vertices
-                            .iter()
-                            .map(|(v, normal)| ((mesh.vertex(*v as usize) - x).norm(), normal))
-                            .min_by(|a, b| a.0.total_cmp(&b.0))
-                            .filter(|(d, _)| *d <= reach)
-                            .map(|(_, normal)| (n as u32, *normal))
-                    })
-                    .collect();
-                if nodes.is_empty() {
-                    return Err(scene.value_error(
-                        format!("boundaries[{i}].group"),
-                        format!(
-                            "no {} node lies outside the mesh near the group",
-                            ctx.kernel.name()
-                        ),
-                    ));
-                }
-                match kind {
-                    BoundaryKind::Fixed => {
-                        sim.boundary().fixed.extend(nodes.iter().map(|(n, _)| *n))
-                    }
-                    BoundaryKind::Slip => sim.boundary().slip.extend(nodes.iter().copied()),
-                }
-                sim.boundary()
-                    .reaction_sets
-                    .push(nodes.iter().map(|(n, _)| *n).collect());
-            }
-            BoundaryTarget::Vertices(vertices) => {
-                match kind {
-                    BoundaryKind::Fixed => sim
-                        .boundary()
-                        .fixed
-                        .extend(vertices.iter().map(|(v, _)| *v)),
-                    BoundaryKind::Slip => sim.boundary().slip.extend(vertices.iter().copied()),
-                }
-                let nodes = vertices.iter().map(|(v, _)| *v).collect();
-                sim.boundary().reaction_sets.push(nodes);
-            }
-            BoundaryTarget::Region { region, normal } => {
-                let frame = &ctx.setup.frame;
-                let nodes: Vec<u32> = sim
-                    .node_positions()
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, x)| region.contains(&frame.point_to_scene(x)))
-                    .map(|(n, _)| n as u32)
-                    .collect();
-                if nodes.is_empty() {
-                    return Err(scene.value_error(
-                        format!("boundaries[{i}].region"),
-                        format!("holds no {} node", ctx.kernel.name()),
-                    ));
-                }
-                match normal {
-                    None => sim.boundary().fixed.extend(nodes.iter().copied()),
-                    Some(n) => sim.boundary().slip.extend(nodes.iter().map(|&v| (v, *n))),
-                }
-                sim.boundary().reaction_sets.push(nodes);
-            }
-        }
-    }
-    Ok(())
 }
 
 /// `check_header` guarantees a time step setting; this keeps the match total without a panic.

@@ -1,0 +1,123 @@
+//! The scene's boundary conditions on the kernel's nodes: planes become walls, mesh
+//! groups become node sets (a staircase of outside nodes for a grid), regions select the
+//! nodes inside them; each condition's nodes also become a reaction set, so its force is
+//! reported.
+
+use nalgebra::SVector;
+use umls_engine::{Wall, WallKind};
+
+use crate::error::Result;
+use crate::run::{Context, Run};
+use crate::schema::{BoundaryKind, KernelKind};
+use crate::setup::BoundaryTarget;
+
+/// Walls on planes, and fixed or slip conditions on the nodes of mesh groups.
+pub(crate) fn apply_boundaries<const D: usize>(
+    ctx: &Context<'_, D>,
+    sim: &mut dyn Run<D>,
+) -> Result<()> {
+    let scene = ctx.scene;
+    let mesh_kernel = matches!(ctx.kernel, KernelKind::Umls | KernelKind::LinearFe);
+    for (i, (kind, target)) in ctx.setup.boundaries.iter().enumerate() {
+        let wall_kind = match kind {
+            BoundaryKind::Fixed => WallKind::Fixed,
+            BoundaryKind::Slip => WallKind::Slip,
+        };
+        match target {
+            BoundaryTarget::Plane { point, normal } => {
+                let tolerance = 1e-6 * sim.spacing();
+                let wall =
+                    Wall::facing(wall_kind, *point, *normal, sim.positions()).ok_or_else(|| {
+                        scene.value_error(
+                            format!("boundaries[{i}].plane.normal"),
+                            "must not be zero",
+                        )
+                    })?;
+                let nodes = sim.add_wall(wall, tolerance);
+                if nodes.is_empty() {
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].plane"),
+                        format!("no {} node lies on or beyond the plane", ctx.kernel.name()),
+                    ));
+                }
+                sim.boundary().reaction_sets.push(nodes);
+            }
+            BoundaryTarget::Vertices(vertices) if !mesh_kernel => {
+                // A grid sees the group as a staircase: its nodes outside the mesh near
+                // the group take the condition, with the nearest group vertex's normal.
+                let Some(mesh) = ctx.setup.background.mesh() else {
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].group"),
+                        "a group condition needs the mesh it belongs to",
+                    ));
+                };
+                let reach = 3.0 * sim.spacing();
+                let nodes: Vec<(u32, SVector<f64, D>)> = sim
+                    .node_positions()
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, x)| mesh.locate(x).is_none())
+                    .filter_map(|(n, x)| {
+                        vertices
+                            .iter()
+                            .map(|(v, normal)| ((mesh.vertex(*v as usize) - x).norm(), normal))
+                            .min_by(|a, b| a.0.total_cmp(&b.0))
+                            .filter(|(d, _)| *d <= reach)
+                            .map(|(_, normal)| (n as u32, *normal))
+                    })
+                    .collect();
+                if nodes.is_empty() {
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].group"),
+                        format!(
+                            "no {} node lies outside the mesh near the group",
+                            ctx.kernel.name()
+                        ),
+                    ));
+                }
+                match kind {
+                    BoundaryKind::Fixed => {
+                        sim.boundary().fixed.extend(nodes.iter().map(|(n, _)| *n))
+                    }
+                    BoundaryKind::Slip => sim.boundary().slip.extend(nodes.iter().copied()),
+                }
+                sim.boundary()
+                    .reaction_sets
+                    .push(nodes.iter().map(|(n, _)| *n).collect());
+            }
+            BoundaryTarget::Vertices(vertices) => {
+                match kind {
+                    BoundaryKind::Fixed => sim
+                        .boundary()
+                        .fixed
+                        .extend(vertices.iter().map(|(v, _)| *v)),
+                    BoundaryKind::Slip => sim.boundary().slip.extend(vertices.iter().copied()),
+                }
+                let nodes = vertices.iter().map(|(v, _)| *v).collect();
+                sim.boundary().reaction_sets.push(nodes);
+            }
+            BoundaryTarget::Region { region, normal } => {
+                let frame = &ctx.setup.frame;
+                let nodes: Vec<u32> = sim
+                    .node_positions()
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, x)| region.contains(&frame.point_to_scene(x)))
+                    .map(|(n, _)| n as u32)
+                    .collect();
+                if nodes.is_empty() {
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].region"),
+                        format!("holds no {} node", ctx.kernel.name()),
+                    ));
+                }
+                match normal {
+                    None => sim.boundary().fixed.extend(nodes.iter().copied()),
+                    Some(n) => sim.boundary().slip.extend(nodes.iter().map(|&v| (v, *n))),
+                }
+                sim.boundary().reaction_sets.push(nodes);
+            }
+        }
+    }
+    Ok(())
+}
