@@ -9,6 +9,7 @@ use crate::error::Result;
 use crate::probes::Probes;
 use crate::run::Run;
 use crate::scene::Scene;
+use crate::schema::ProfileSpec;
 use crate::setup::{self, Setup};
 
 /// The end-state metrics of `sim`; `initial` are the particles' initial (world)
@@ -41,6 +42,12 @@ pub(crate) fn end_state<const D: usize>(
             json!(farthest(sim.positions()) - farthest(initial)),
         );
     }
+    if let Some(profile) = &scene.spec.output.profile {
+        metrics.insert(
+            "surface_profile".into(),
+            surface_profile(scene, setup, sim, profile)?,
+        );
+    }
     if !probes.is_empty() {
         let finals: Vec<Vec<f64>> = (0..probes.len())
             .map(|k| {
@@ -58,4 +65,44 @@ pub(crate) fn end_state<const D: usize>(
         metrics.extend(column.metrics(&setup.frame, initial, sim.positions(), &stresses));
     }
     Ok(metrics)
+}
+
+/// The highest particle (along `up`) in each bin along `along`, scene frame; `null` for
+/// an empty bin. Two runs' profiles compare their final surfaces.
+fn surface_profile<const D: usize>(
+    scene: &Scene,
+    setup: &Setup<D>,
+    sim: &dyn Run<D>,
+    spec: &ProfileSpec,
+) -> Result<Value> {
+    let along: SVector<f64, D> = setup::vector(scene, "output.profile.along", &spec.along)?;
+    let up: SVector<f64, D> = setup::vector(scene, "output.profile.up", &spec.up)?;
+    if along.norm() == 0.0 || up.norm() == 0.0 {
+        return Err(scene.value_error("output.profile", "`along` and `up` must not be zero"));
+    }
+    if !(spec.start.is_finite() && spec.end.is_finite() && spec.end > spec.start) {
+        return Err(scene.value_error("output.profile.end", "must exceed `start`"));
+    }
+    if spec.bins == 0 || spec.bins > 100_000 {
+        return Err(scene.value_error("output.profile.bins", "must lie in 1..=100000"));
+    }
+    let (along, up) = (along.normalize(), up.normalize());
+    let width = (spec.end - spec.start) / spec.bins as f64;
+    let mut heights = vec![f64::NEG_INFINITY; spec.bins];
+    for x in sim.positions() {
+        let x = setup.frame.point_to_scene(x);
+        let bin = ((x.dot(&along) - spec.start) / width).floor();
+        if bin >= 0.0 && (bin as usize) < spec.bins {
+            let h = &mut heights[bin as usize];
+            *h = h.max(x.dot(&up));
+        }
+    }
+    let centres: Vec<f64> = (0..spec.bins)
+        .map(|k| spec.start + (k as f64 + 0.5) * width)
+        .collect();
+    let heights: Vec<Option<f64>> = heights
+        .into_iter()
+        .map(|h| h.is_finite().then_some(h))
+        .collect();
+    Ok(json!({ "centres": centres, "heights": heights }))
 }

@@ -44,6 +44,23 @@ pub struct SceneSpec {
     pub body_force: Option<BodyForceSpec>,
 }
 
+/// `[output] profile`: the body's surface height `up` at the end, in `bins` equal bins
+/// along `along` from `start` to `end` (scene frame).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProfileSpec {
+    /// Direction the bins follow.
+    pub along: Vec<f64>,
+    /// Direction of the height.
+    pub up: Vec<f64>,
+    /// Where the bins start and end along `along`.
+    pub start: f64,
+    /// See `start`.
+    pub end: f64,
+    /// Number of bins.
+    pub bins: usize,
+}
+
 /// `[body_force]`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -248,6 +265,8 @@ pub struct OutputSpec {
     /// A direction (scene frame) along which the body's front advance is reported: the
     /// farthest particle at the end against the farthest at the start (a run-out).
     pub front: Option<Vec<f64>>,
+    /// The body's top surface at the end, as heights in bins along a direction.
+    pub profile: Option<ProfileSpec>,
     /// Write diagnostics to `history.csv` every this many steps (default 1).
     #[serde(default = "default_history_every")]
     pub history_every: usize,
@@ -265,6 +284,7 @@ impl Default for OutputSpec {
         Self {
             probes: Vec::new(),
             front: None,
+            profile: None,
             frames: None,
             interval: None,
             history_every: default_history_every(),

@@ -192,5 +192,15 @@ fn slope_starts_to_slide_with_both_kernels() {
             Some(0),
             "{kernel:?}"
         );
+        // The surface profile: 40 bins of 0.1 along x; behind the crest the top has
+        // settled a little below its initial 1.2 (the top particles start at 1.167), and
+        // beyond the toe's reach the bins are empty.
+        let profile = &s["metrics"]["surface_profile"];
+        let heights = profile["heights"].as_array().unwrap();
+        assert_eq!(heights.len(), 40);
+        assert_eq!(profile["centres"][0].as_f64(), Some(0.05));
+        let back = heights[0].as_f64().unwrap();
+        assert!(back < 1.17 && back > 1.0, "{kernel:?}: {back}");
+        assert!(heights[39].is_null(), "{kernel:?}");
     }
 }
