@@ -53,8 +53,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Scenes => {
+            let width = BUILTIN.iter().map(|b| b.name.len()).max().unwrap_or(0);
             for b in BUILTIN {
-                println!("{:<16} {}", b.name, b.summary);
+                println!("{:<width$}  {}", b.name, b.summary);
             }
             Ok(())
         }

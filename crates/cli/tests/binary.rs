@@ -368,9 +368,15 @@ fn scenes_and_help() {
     let out = umls(&["scenes"]);
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
-    for name in ["colliding-disks", "vibrating-bar", "cantilever"] {
-        assert!(text.lines().any(|l| l.starts_with(name)), "{text}");
+    // Every built-in scene, one line each, the summaries in one column.
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), umls_cli::builtin::BUILTIN.len());
+    let mut columns = std::collections::BTreeSet::new();
+    for (line, b) in lines.iter().zip(umls_cli::builtin::BUILTIN) {
+        assert!(line.starts_with(&format!("{}  ", b.name)), "{text}");
+        columns.insert(line.find(b.summary).expect("the summary is listed"));
     }
+    assert_eq!(columns.len(), 1, "{text}");
     for args in [
         &["--help"][..],
         &["run", "--help"],
