@@ -94,38 +94,6 @@ fn mass_and_momentum_are_conserved_for_every_kernel_and_transfer() {
 }
 
 #[test]
-fn results_do_not_depend_on_the_thread_count() {
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
-            let material = NeoHookean {
-                parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
-            };
-            let mut sim = Simulation::new(
-                Umls2::new(mesh()),
-                material,
-                Apic,
-                disk(),
-                StepSettings::new(1e-4),
-            )
-            .unwrap();
-            for _ in 0..10 {
-                sim.step().unwrap();
-            }
-            (
-                sim.particles.position.clone(),
-                sim.particles.velocity.clone(),
-                sim.particles.deformation.clone(),
-            )
-        })
-    };
-    assert_eq!(run(1), run(2));
-}
-
-#[test]
 fn leaving_the_mesh_names_the_particle() {
     let material = NeoHookean {
         parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
@@ -169,59 +137,52 @@ fn leaving_the_mesh_names_the_particle() {
 }
 
 /// Above the parallel-scatter threshold (8192 particles) the P2G scatter runs in eight
-/// blocks: results are still bitwise identical for 1 and 2 threads, and momentum is
-/// still conserved to round-off.
+/// blocks, here on two threads: momentum is still conserved to round-off (that the
+/// results do not depend on the thread count is `determinism.rs`).
 #[test]
-fn blocked_scatter_is_deterministic_and_conservative() {
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
-            let samples = umls_engine::lattice_samples(
-                SVector::from([0.1, 0.1]),
-                SVector::from([0.9, 0.9]),
-                0.0075,
-            );
-            let swirl = |x: &Vector2<f64>| {
-                Vector2::new(-(x.y - 0.5), x.x - 0.5) * 0.5 + Vector2::new(0.05, -0.02)
-            };
-            let particles = Particles::seed(
-                &samples,
-                &umls_engine::Region::Everywhere,
-                1000.0,
-                (),
-                swirl,
-            );
-            assert!(particles.len() > 8192);
-            let material = NeoHookean {
-                parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
-            };
-            let mut sim = Simulation::new(
-                Umls2::new(mesh()),
-                material,
-                Apic,
-                particles,
-                StepSettings::new(1e-4),
-            )
-            .unwrap();
-            let before = sim.diagnostics().unwrap().momentum;
-            for _ in 0..3 {
-                sim.step().unwrap();
-            }
-            let after = sim.diagnostics().unwrap().momentum;
-            assert!(
-                (after - before).norm() < 1e-12 * before.norm() * 1e3,
-                "{before:?} → {after:?}"
-            );
-            (
-                sim.particles.position.clone(),
-                sim.particles.velocity.clone(),
-            )
-        })
-    };
-    assert_eq!(run(1), run(2));
+fn blocked_scatter_conserves_momentum() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let samples = umls_engine::lattice_samples(
+            SVector::from([0.1, 0.1]),
+            SVector::from([0.9, 0.9]),
+            0.0075,
+        );
+        let swirl = |x: &Vector2<f64>| {
+            Vector2::new(-(x.y - 0.5), x.x - 0.5) * 0.5 + Vector2::new(0.05, -0.02)
+        };
+        let particles = Particles::seed(
+            &samples,
+            &umls_engine::Region::Everywhere,
+            1000.0,
+            (),
+            swirl,
+        );
+        assert!(particles.len() > 8192);
+        let material = NeoHookean {
+            parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
+        };
+        let mut sim = Simulation::new(
+            Umls2::new(mesh()),
+            material,
+            Apic,
+            particles,
+            StepSettings::new(1e-4),
+        )
+        .unwrap();
+        let before = sim.diagnostics().unwrap().momentum;
+        for _ in 0..3 {
+            sim.step().unwrap();
+        }
+        let after = sim.diagnostics().unwrap().momentum;
+        assert!(
+            (after - before).norm() < 1e-12 * before.norm() * 1e3,
+            "{before:?} → {after:?}"
+        );
+    });
 }
 
 /// An ill-conditioned MLS system (sliver mesh of aspect 10⁷) stops the run with the
