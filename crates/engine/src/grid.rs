@@ -156,7 +156,7 @@ impl<const D: usize> Grid<D> {
         cancellation_fraction: f64,
         damping: Damping,
         boundary: &Boundary<D>,
-        reactions: &mut (ReactionScratch<D>, Vec<crate::boundary::Reaction<D>>),
+        mut reactions: Option<&mut (ReactionScratch<D>, Vec<crate::boundary::Reaction<D>>)>,
     ) -> GridUpdateReport<D> {
         let mut report = GridUpdateReport {
             dropped_mass: 0.0,
@@ -164,10 +164,8 @@ impl<const D: usize> Grid<D> {
             scaled_nodes: 0,
         };
         let mut active_mass = 0.0;
-        if !boundary.reaction_sets.is_empty() {
-            reactions
-                .0
-                .record(boundary, &self.momentum, &self.force, dt);
+        if let Some(r) = reactions.as_deref_mut() {
+            r.0.record(boundary, &self.momentum, &self.force, dt);
         }
         if let Damping::Local { .. } = damping {
             // Local damping acts per component on the force the node is free to follow:
@@ -229,14 +227,8 @@ impl<const D: usize> Grid<D> {
         }
         boundary.apply(&mut self.velocity);
         boundary.apply(&mut self.new_velocity);
-        if !boundary.reaction_sets.is_empty() {
-            reactions.0.reactions(
-                boundary,
-                &self.mass,
-                &self.new_velocity,
-                dt,
-                &mut reactions.1,
-            );
+        if let Some(r) = reactions {
+            r.0.reactions(boundary, &self.mass, &self.new_velocity, dt, &mut r.1);
         }
         report
     }

@@ -75,6 +75,10 @@ pub struct StepSettings<const D: usize> {
     /// mass to cancelling (negative) MLS values: it carries no velocity, and its mass and
     /// momentum are reported as dropped.
     pub cancellation_fraction: f64,
+    /// Whether the next step sums the forces of `Boundary::reaction_sets` (on by
+    /// default). A run that reads them only now and then switches it off for the steps
+    /// in between; an unmeasured step leaves no reactions to read.
+    pub measure_reactions: bool,
 }
 
 impl<const D: usize> StepSettings<D> {
@@ -93,6 +97,7 @@ impl<const D: usize> StepSettings<D> {
             max_courant: 1.0,
             max_wave_courant: 1.0,
             cancellation_fraction: 1e-3,
+            measure_reactions: true,
         }
     }
 

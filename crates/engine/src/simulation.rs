@@ -319,7 +319,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     }
 
     /// The forces the constraints of each of `boundary.reaction_sets` exerted on the
-    /// body in the last step (empty before the first step or without sets).
+    /// body in the last step (empty before the first step, without sets, or when
+    /// `settings.measure_reactions` was off for it).
     pub fn reactions(&self) -> &[crate::boundary::Reaction<D>] {
         &self.reactions.1
     }
@@ -514,14 +515,19 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         self.times.constitutive += clock.lap();
         self.particles_to_grid();
         self.times.particles_to_grid += clock.lap();
-        // 3. Grid update.
+        // 3. Grid update, summing the reaction sets' forces only when they will be read.
+        let measure = self.settings.measure_reactions && !self.boundary.reaction_sets.is_empty();
+        if !measure {
+            self.reactions.1.clear();
+            self.reactions.0.nodal.clear();
+        }
         let report = self.grid.update(
             dt,
             self.material.p_wave_modulus(),
             self.settings.cancellation_fraction,
             self.settings.damping,
             &self.boundary,
-            &mut self.reactions,
+            measure.then_some(&mut self.reactions),
         );
         self.totals.dropped_mass += report.dropped_mass;
         self.totals.redistributed_momentum += report.redistributed_momentum;
