@@ -445,9 +445,7 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
         names.iter().copied().zip(maxima).collect()
     }
     fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> Vec<u32> {
-        let nodes = Boundary::nodes_of_wall(&self.kernel, &wall, tolerance);
-        self.boundary.add_wall(&self.kernel, wall, tolerance);
-        nodes
+        self.boundary.add_wall(&self.kernel, wall, tolerance)
     }
     fn boundary(&mut self) -> &mut Boundary<D> {
         &mut self.boundary

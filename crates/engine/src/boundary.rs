@@ -140,18 +140,20 @@ impl<const D: usize> Boundary<D> {
     }
 
     /// Adds `wall`: constrains its nodes (on the plane within `tolerance`, or beyond it)
-    /// and keeps particles on the material side. Returns the number of nodes constrained.
-    pub fn add_wall<K: Kernel<D>>(&mut self, kernel: &K, wall: Wall<D>, tolerance: f64) -> usize {
+    /// and keeps particles on the material side. Returns the nodes constrained.
+    pub fn add_wall<K: Kernel<D>>(
+        &mut self,
+        kernel: &K,
+        wall: Wall<D>,
+        tolerance: f64,
+    ) -> Vec<u32> {
         let nodes = Self::nodes_of_wall(kernel, &wall, tolerance);
-        let count = nodes.len();
         match wall.kind {
-            WallKind::Fixed => self.fixed.extend(nodes),
-            WallKind::Slip => self
-                .slip
-                .extend(nodes.into_iter().map(|n| (n, wall.normal))),
+            WallKind::Fixed => self.fixed.extend(nodes.iter().copied()),
+            WallKind::Slip => self.slip.extend(nodes.iter().map(|&n| (n, wall.normal))),
         }
         self.walls.push(wall);
-        count
+        nodes
     }
 
     /// Applies the node conditions to grid velocities.

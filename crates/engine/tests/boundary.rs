@@ -210,8 +210,8 @@ fn conditions_on_planes() {
     .unwrap();
     assert_eq!(top.normal, Vector2::new(0.0, 1.0));
     let mut boundary = umls_engine::Boundary::<2>::default();
-    assert_eq!(boundary.add_wall(&kernel, left, 1e-9), 5);
-    assert_eq!(boundary.add_wall(&kernel, top, 1e-9), 10);
+    assert_eq!(boundary.add_wall(&kernel, left, 1e-9).len(), 5);
+    assert_eq!(boundary.add_wall(&kernel, top, 1e-9).len(), 10);
     assert_eq!(boundary.fixed, vec![0, 5, 10, 15, 20]);
     assert_eq!(boundary.slip.len(), 10);
     assert!(

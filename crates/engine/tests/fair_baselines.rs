@@ -286,7 +286,7 @@ fn column<K: Kernel<2>>(kernel: K, geostatic: bool, band: (f64, f64)) -> f64 {
             &positions,
         )
         .unwrap();
-        assert!(sim.boundary.add_wall(&sim.kernel, wall, 1e-9) > 0);
+        assert!(!sim.boundary.add_wall(&sim.kernel, wall, 1e-9).is_empty());
     }
     let end = if geostatic {
         sim.set_geostatic_stress(0.3 / 0.7).unwrap();
