@@ -26,7 +26,8 @@ pub struct WallPressure<const D: usize> {
     area: f64,
     directions: Vec<SVector<f64, D>>,
     history: Vec<f64>,
-    /// Angular roughness at the row of the largest pressure.
+    /// The largest pressure so far, and the angular roughness at its row.
+    peak: f64,
     peak_roughness: f64,
 }
 
@@ -62,6 +63,7 @@ impl<const D: usize> WallPressure<D> {
             area,
             directions,
             history: Vec::new(),
+            peak: 0.0,
             peak_roughness: 0.0,
         }
     }
@@ -85,7 +87,8 @@ impl<const D: usize> WallPressure<D> {
             bins[bin] += magnitude;
         }
         let pressure = total / self.area;
-        if self.history.iter().all(|&p| pressure > p) && total > 0.0 {
+        if pressure > self.peak {
+            self.peak = pressure;
             let mean = total / BINS as f64;
             let variance = bins.iter().map(|b| (b - mean).powi(2)).sum::<f64>() / BINS as f64;
             self.peak_roughness = variance.sqrt() / mean;
@@ -96,7 +99,7 @@ impl<const D: usize> WallPressure<D> {
 
     /// `pressure_max`, `pressure_time_roughness`, `pressure_angular_roughness`.
     pub fn metrics(&self) -> Map<String, Value> {
-        let max = self.history.iter().copied().fold(0.0, f64::max);
+        let max = self.peak;
         let second: Vec<f64> = self
             .history
             .windows(3)

@@ -372,7 +372,7 @@ pub(crate) trait Run<const D: usize> {
     /// Adds a wall; the nodes it constrains.
     fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> Vec<u32>;
     /// The constraint forces of the boundary's reaction sets in the last step.
-    fn reactions(&self) -> Vec<umls_engine::Reaction<D>>;
+    fn reactions(&self) -> &[umls_engine::Reaction<D>];
     /// Each reaction-set node's reaction, the sets one after the other.
     fn node_reactions(&self) -> &[SVector<f64, D>];
     /// The node sets whose reactions are summed.
@@ -422,8 +422,8 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
     fn spacing(&self) -> f64 {
         self.kernel.spacing()
     }
-    fn reactions(&self) -> Vec<umls_engine::Reaction<D>> {
-        Simulation::reactions(self).to_vec()
+    fn reactions(&self) -> &[umls_engine::Reaction<D>] {
+        Simulation::reactions(self)
     }
     fn node_reactions(&self) -> &[SVector<f64, D>] {
         Simulation::node_reactions(self)
