@@ -1,8 +1,11 @@
 //! Project automation, run as `cargo xtask <command>`:
 //!
 //! - `ci`: format check, clippy with `-D warnings`, and the whole test suite in release mode.
-//! - `bench [FILTER]`: the criterion benches of every crate, then a Markdown table of the
-//!   results in `target/bench-report.md`.
+//! - `bench [--quick] [--save-baseline NAME | --baseline NAME] [--docs]`: the comparison
+//!   report in `target/report/` (`umls report`: the study matrix of scenes × kernels ×
+//!   resolutions, charts, raw results), after the criterion benches of every crate
+//!   (skipped by `--quick`, whose matrix has coarse levels only); `--docs` copies the
+//!   report to `docs/report/`.
 //! - `deny`: `cargo deny check` (needs `cargo install cargo-deny`).
 
 use std::path::{Path, PathBuf};
@@ -12,10 +15,12 @@ fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
         Some("ci") => ci(),
-        Some("bench") => bench(args.get(1).map(String::as_str)),
+        Some("bench") => bench(&args[1..]),
         Some("deny") => cargo(&["deny", "check"]),
         _ => {
-            eprintln!("usage: cargo xtask <ci | bench [FILTER] | deny>");
+            eprintln!(
+                "usage: cargo xtask <ci | bench [--quick] [--save-baseline NAME | --baseline NAME] [--docs] | deny>"
+            );
             return ExitCode::from(2);
         }
     };
@@ -74,17 +79,102 @@ fn ci() -> Result<(), String> {
     cargo(&["test", "--workspace", "--release"])
 }
 
-fn bench(filter: Option<&str>) -> Result<(), String> {
-    let mut args = vec!["bench", "--workspace"];
-    if let Some(f) = filter {
-        args.extend(["--", f]);
+/// What `cargo xtask bench` was asked for.
+#[derive(Debug, Default)]
+struct BenchArgs {
+    quick: bool,
+    save_baseline: Option<String>,
+    baseline: Option<String>,
+    docs: bool,
+}
+
+fn bench_args(args: &[String]) -> Result<BenchArgs, String> {
+    let mut parsed = BenchArgs::default();
+    let mut rest = args.iter();
+    while let Some(arg) = rest.next() {
+        let mut value = |name: &str| {
+            rest.next()
+                .cloned()
+                .ok_or_else(|| format!("{name} needs a baseline name"))
+        };
+        match arg.as_str() {
+            "--quick" => parsed.quick = true,
+            "--docs" => parsed.docs = true,
+            "--save-baseline" => parsed.save_baseline = Some(value("--save-baseline")?),
+            "--baseline" => parsed.baseline = Some(value("--baseline")?),
+            other => return Err(format!("bench: unknown argument `{other}`")),
+        }
     }
-    cargo(&args)?;
-    let report = report::collect(&workspace_root().join("target/criterion"))?;
-    let path = workspace_root().join("target/bench-report.md");
-    std::fs::write(&path, report).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    eprintln!("xtask: wrote {}", path.display());
+    Ok(parsed)
+}
+
+fn bench(args: &[String]) -> Result<(), String> {
+    let args = bench_args(args)?;
+    let root = workspace_root();
+    if !args.quick {
+        let mut criterion = vec!["bench", "--workspace", "--"];
+        if let Some(name) = &args.save_baseline {
+            criterion.extend(["--save-baseline", name]);
+        }
+        if let Some(name) = &args.baseline {
+            criterion.extend(["--baseline", name]);
+        }
+        cargo(&criterion)?;
+    }
+    cargo(&["build", "--release", "-p", "umls-cli"])?;
+    let out = root.join("target/report");
+    let exe = root.join("target/release/umls");
+    let mut command = Command::new(&exe);
+    command
+        .current_dir(&root)
+        .args([
+            "report",
+            "--matrix",
+            if args.quick { "quick" } else { "full" },
+        ])
+        .arg("--out")
+        .arg(&out)
+        .arg("--criterion")
+        .arg(root.join("target/criterion"))
+        .args([
+            "--criterion-current",
+            args.save_baseline.as_deref().unwrap_or("new"),
+        ]);
+    if let Some(name) = &args.baseline {
+        command.args(["--baseline", name]);
+    }
+    eprintln!("xtask: {} report ...", exe.display());
+    let status = command
+        .status()
+        .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
+    if !status.success() {
+        return Err(format!("`umls report` failed ({status})"));
+    }
+    if args.docs {
+        publish(&out, &root.join("docs/report"))?;
+    }
     Ok(())
 }
 
-mod report;
+/// Copies the report (not the runs' directories) to `docs`, replacing what was there.
+fn publish(report: &Path, docs: &Path) -> Result<(), String> {
+    let fail = |p: &Path, e: std::io::Error| format!("{}: {e}", p.display());
+    if docs.exists() {
+        std::fs::remove_dir_all(docs).map_err(|e| fail(docs, e))?;
+    }
+    for sub in ["charts", "histories"] {
+        let (from, to) = (report.join(sub), docs.join(sub));
+        std::fs::create_dir_all(&to).map_err(|e| fail(&to, e))?;
+        for entry in std::fs::read_dir(&from).map_err(|e| fail(&from, e))? {
+            let path = entry.map_err(|e| fail(&from, e))?.path();
+            let target = to.join(path.file_name().unwrap_or_default());
+            std::fs::copy(&path, &target).map_err(|e| fail(&path, e))?;
+        }
+    }
+    for file in ["report.md", "results.csv", "results.json"] {
+        let target = docs.join(file);
+        std::fs::copy(report.join(file), &target).map_err(|e| fail(&target, e))?;
+    }
+    eprintln!("xtask: copied the report to {}", docs.display());
+    Ok(())
+}

@@ -30,11 +30,13 @@
 pub mod background;
 pub mod builtin;
 mod conditions;
+pub mod edit;
 mod end_metrics;
 mod error;
 pub mod expression;
 pub mod frame;
 pub mod hydrostatic;
+mod memory;
 pub mod mesh_info;
 mod output;
 pub mod plot;

@@ -617,6 +617,9 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     // (kinetic + elastic) of the run, which stays meaningful when E(0) is 0 (a body
     // released from rest under gravity).
     let (mut energy_change, mut energy_scale) = (0.0f64, d0.kinetic + d0.elastic);
+    // The largest gain E(t) − E(0) alone: energy the scheme created (dissipation is a
+    // loss and does not count), for stability maps.
+    let mut energy_gain = 0.0f64;
     let (mut error_sum, mut error_max) = (0.0f64, 0.0f64);
     let progress = Progress::new(ctx.options.progress, steps as u64, &spec.scene.name);
     let start = Instant::now();
@@ -662,6 +665,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
             max_wave_courant = max_wave_courant.max(d.wave_courant);
             energies.push(r);
             energy_change = energy_change.max((total - e0).abs());
+            energy_gain = energy_gain.max(total - e0);
             last_total = total;
             energy_scale = energy_scale.max(d.kinetic + d.elastic);
             last = d;
@@ -721,6 +725,18 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         0.0
     };
     metrics.insert("energy_error".into(), json!(energy_error));
+    let relative = |e: f64| {
+        if energy_scale > 0.0 {
+            e / energy_scale
+        } else {
+            0.0
+        }
+    };
+    metrics.insert("energy_gain_max".into(), json!(relative(energy_gain)));
+    metrics.insert(
+        "energy_change_final".into(),
+        json!(relative(last_total - e0)),
+    );
     metrics.insert("initial_energy".into(), json!(e0));
     metrics.insert("final_energy".into(), json!(last_total));
     metrics.insert(
@@ -792,6 +808,12 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
             Some(_) => "failed",
         },
         "error": failure.as_ref().map(|e| e.to_string()),
+        "failure_kind": match &failure {
+            Some(CliError::Engine(e)) => Some(e.kind()),
+            Some(CliError::Interrupted { .. }) | None => None,
+            Some(_) => Some("other"),
+        },
+        "peak_memory_bytes": crate::memory::peak_resident_bytes(),
         "wall_time_s": wall,
         "stage_seconds": stage_seconds(&sim.stage_times()),
         "particle_steps_per_second": if wall > 0.0 { (sim.positions().len() * taken) as f64 / wall } else { 0.0 },

@@ -34,8 +34,21 @@ impl Scene {
 
     /// A built-in scene by name, or else a scene file at that path.
     pub fn load(name_or_path: &str) -> Result<Self> {
+        Self::load_with(name_or_path, &[])
+    }
+
+    /// [`Scene::load`] with values replaced first (`umls run --set KEY=VALUE`; see
+    /// [`crate::edit::override_text`]).
+    pub fn load_with(name_or_path: &str, assignments: &[(String, String)]) -> Result<Self> {
+        let (text, label, base) = Self::text(name_or_path)?;
+        let text = crate::edit::override_text(&text, &label, assignments)?;
+        Self::parse(&text, &label, base)
+    }
+
+    /// The text of a built-in scene or scene file, its label and its base directory.
+    fn text(name_or_path: &str) -> Result<(String, String, Option<PathBuf>)> {
         if let Some(builtin) = BUILTIN.iter().find(|b| b.name == name_or_path) {
-            return Self::parse(builtin.toml, builtin.name, None);
+            return Ok((builtin.toml.to_string(), builtin.name.to_string(), None));
         }
         let path = Path::new(name_or_path);
         if path.is_dir() {
@@ -61,7 +74,7 @@ impl Scene {
             source,
         })?;
         let base = path.parent().map(Path::to_path_buf);
-        Self::parse(&text, &path.display().to_string(), base)
+        Ok((text, path.display().to_string(), base))
     }
 
     /// An error about `key`.

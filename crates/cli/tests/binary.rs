@@ -502,6 +502,13 @@ fn an_unstable_run_leaves_its_history_and_says_why() {
     let s = summary(&dir.join("out"));
     assert_eq!(s["status"], "failed");
     assert!(s["error"].as_str().unwrap().contains("step"));
+    // The kind of failure is named for tables and stability maps: 200 times the stable
+    // step is caught by the wave Courant check after the first step.
+    assert_eq!(s["failure_kind"], "time-step-too-large");
+    // The process measured its own peak memory (Linux reports it).
+    if cfg!(target_os = "linux") {
+        assert!(s["peak_memory_bytes"].as_u64().unwrap() > 1 << 20);
+    }
     let (_, rows) = history(&dir.join("out"));
     assert!(!rows.is_empty());
     // The time step was 0.2 / 1e-3 = 200 times the one the scene is stable with: said

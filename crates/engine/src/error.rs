@@ -114,3 +114,22 @@ pub enum EngineError {
         reason: &'static str,
     },
 }
+
+impl EngineError {
+    /// A short name of the kind of failure, for tables and stability maps: `kernel`,
+    /// `material`, `non-finite`, `inverted`, `energy-blow-up`, `too-fast`,
+    /// `time-step-too-large`, `initial-stress` or `invalid-parameter`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Kernel { .. } => "kernel",
+            Self::Material { .. } => "material",
+            Self::NonFinite { .. } => "non-finite",
+            Self::Inverted { .. } => "inverted",
+            Self::EnergyBlowUp { .. } => "energy-blow-up",
+            Self::Unstable { .. } => "too-fast",
+            Self::TimeStepTooLarge { .. } => "time-step-too-large",
+            Self::InitialStress { .. } => "initial-stress",
+            Self::InvalidParameter { .. } => "invalid-parameter",
+        }
+    }
+}

@@ -6,7 +6,7 @@
 //! - [`vtk`]: write `.vtu` files (particles as point clouds with fields, meshes with
 //!   node and cell fields) and `.pvd` collections that ParaView opens as an animation.
 //! - [`csv`]: write time histories with a header row.
-//! - [`chart`]: line charts as SVG, with titles, axis labels that carry units, optional
+//! - [`chart`]: line charts, stability maps and stacked bars as SVG, with titles, axis labels that carry units, optional
 //!   log axes and a legend beside the plot, shared by the command line, the examples and
 //!   the bench report.
 //!

@@ -1,101 +1,11 @@
-//! Line charts as SVG files a browser opens: one helper for every chart the project
-//! draws, so they all read the same way — a title, axis labels with units, tick labels
-//! large enough to read, optional logarithmic axes for data spanning decades, and the
-//! legend in a panel beside the plot where it cannot cover a curve. Non-finite points
-//! (and non-positive ones on a log axis) are left out rather than allowed to break the
-//! axis ranges.
-//!
-//! ```
-//! use umls_io::chart::{Axis, LineChart, Series};
-//!
-//! let chart = LineChart {
-//!     title: "Energy of the colliding disks".into(),
-//!     x: Axis::linear("time t [s]"),
-//!     y: Axis::linear("energy [J/m]"),
-//!     series: vec![Series::new("kinetic", vec![(0.0, 1.0), (1.0, 0.5), (2.0, 0.9)])],
-//! };
-//! let svg = chart.to_svg()?;
-//! assert!(svg.contains("kinetic") && svg.contains("time t [s]"));
-//! # Ok::<(), umls_io::IoError>(())
-//! ```
+//! Line charts: curves over linear or logarithmic axes, with optional markers.
 
 use std::path::Path;
 
 use plotters::prelude::*;
 
-use crate::error::{IoError, Result};
-
-/// Width and height of a chart in pixels.
-const SIZE: (u32, u32) = (1100, 600);
-/// Width of the legend panel on the right.
-const LEGEND_WIDTH: u32 = 230;
-
-/// Colours cycled through the series: distinguishable, and readable on white.
-const PALETTE: [RGBColor; 8] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(0, 0, 0),
-    RGBColor(148, 103, 189),
-    RGBColor(255, 127, 14),
-    RGBColor(23, 190, 207),
-    RGBColor(140, 86, 75),
-];
-
-/// One axis: its label (with the unit in brackets) and its scale.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Axis {
-    /// Label, e.g. "time t [s]".
-    pub label: String,
-    /// Logarithmic scale.
-    pub log: bool,
-}
-
-impl Axis {
-    /// A linear axis.
-    pub fn linear(label: impl Into<String>) -> Self {
-        Self {
-            label: label.into(),
-            log: false,
-        }
-    }
-
-    /// A logarithmic axis (only positive values are drawn).
-    pub fn log(label: impl Into<String>) -> Self {
-        Self {
-            label: label.into(),
-            log: true,
-        }
-    }
-}
-
-/// One curve.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Series {
-    /// Legend entry.
-    pub label: String,
-    /// (x, y) points, drawn in order.
-    pub points: Vec<(f64, f64)>,
-    /// Draw markers at the points as well as the line (for few points).
-    pub markers: bool,
-}
-
-impl Series {
-    /// A line through `points`.
-    pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
-        Self {
-            label: label.into(),
-            points,
-            markers: false,
-        }
-    }
-
-    /// The same series with markers at its points.
-    pub fn with_markers(mut self) -> Self {
-        self.markers = true;
-        self
-    }
-}
+use super::{Axis, LEGEND_WIDTH, PALETTE, SIZE, Series, svg_string, write_svg};
+use crate::error::Result;
 
 /// A line chart.
 #[derive(Debug, Clone, PartialEq)]
@@ -113,25 +23,12 @@ pub struct LineChart {
 impl LineChart {
     /// The chart as an SVG document.
     pub fn to_svg(&self) -> Result<String> {
-        let mut svg = String::new();
-        self.draw(SVGBackend::with_string(&mut svg, SIZE))
-            .map_err(|message| IoError::Chart {
-                path: "<memory>".into(),
-                message,
-            })?;
-        Ok(svg)
+        svg_string(SIZE, |backend| self.draw(backend))
     }
 
     /// Writes the chart to `path` as SVG.
     pub fn write_svg(&self, path: &Path) -> Result<()> {
-        let svg = self.to_svg().map_err(|e| match e {
-            IoError::Chart { message, .. } => IoError::Chart {
-                path: path.to_path_buf(),
-                message,
-            },
-            other => other,
-        })?;
-        crate::write_file(path, svg.as_bytes())
+        write_svg(path, self.to_svg())
     }
 
     /// The points of a series that the axes can show.
@@ -192,8 +89,10 @@ impl LineChart {
                     .y_desc(self.y.label.as_str())
                     .axis_desc_style(("sans-serif", 19))
                     .label_style(("sans-serif", 15))
-                    .x_labels(8)
-                    .y_labels(8)
+                    .x_labels(12)
+                    .y_labels(12)
+                    .x_label_formatter(&|v| tick_label(*v, self.x.log))
+                    .y_label_formatter(&|v| tick_label(*v, self.y.log))
                     .draw()
                     .map_err(|e| e.to_string())?;
                 for (i, series) in self.series.iter().enumerate() {
@@ -217,28 +116,80 @@ impl LineChart {
         }
         match (self.x.log, self.y.log) {
             (false, false) => plot!(x0..x1, y0..y1),
-            (true, false) => plot!((x0..x1).log_scale(), y0..y1),
-            (false, true) => plot!(x0..x1, (y0..y1).log_scale()),
-            (true, true) => plot!((x0..x1).log_scale(), (y0..y1).log_scale()),
+            (true, false) => plot!(
+                (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
+                y0..y1
+            ),
+            (false, true) => plot!(
+                x0..x1,
+                (y0..y1).log_scale().with_key_points(log_ticks(y0, y1))
+            ),
+            (true, true) => plot!(
+                (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
+                (y0..y1).log_scale().with_key_points(log_ticks(y0, y1))
+            ),
         }
-        for (i, series) in self.series.iter().enumerate() {
-            let colour = PALETTE[i % PALETTE.len()];
-            let y = 70 + 30 * i as i32;
-            legend_area
-                .draw(&PathElement::new(
-                    vec![(10, y), (40, y)],
-                    colour.stroke_width(3),
-                ))
-                .map_err(|e| e.to_string())?;
-            legend_area
-                .draw(&Text::new(
-                    series.label.clone(),
-                    (48, y - 9),
-                    ("sans-serif", 17).into_font(),
-                ))
-                .map_err(|e| e.to_string())?;
-        }
+        let entries: Vec<(String, RGBColor)> = self
+            .series
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (s.label.clone(), PALETTE[i % PALETTE.len()]))
+            .collect();
+        super::draw_legend(&legend_area, &entries, false)?;
         root.present().map_err(|e| e.to_string())
+    }
+}
+
+/// Tick positions on a log axis from `lo` to `hi`: the powers of ten, with 2 and 5
+/// times them when the range spans few decades, and every digit when it spans less than
+/// one — so a narrow range still shows several labelled ticks.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let decades = (hi / lo).log10();
+    let mantissas: &[f64] = match decades {
+        d if d > 4.0 => &[1.0],
+        d if d > 1.5 => &[1.0, 2.0, 5.0],
+        _ => &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
+    };
+    let mut ticks = Vec::new();
+    let mut power = 10f64.powi(lo.log10().floor() as i32);
+    while power <= hi {
+        for m in mantissas {
+            let t = m * power;
+            if t >= lo && t <= hi {
+                ticks.push(t);
+            }
+        }
+        power *= 10.0;
+    }
+    ticks
+}
+
+/// A tick label: short decimals on linear axes, `2e-4` style on log axes.
+pub(super) fn tick_label(v: f64, log: bool) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    let magnitude = v.abs().log10();
+    if log && !(-2.0..4.0).contains(&magnitude) {
+        let exponent = magnitude.floor() as i32;
+        let mantissa = v / 10f64.powi(exponent);
+        let mantissa = (mantissa * 10.0).round() / 10.0;
+        if mantissa == 1.0 {
+            format!("1e{exponent}")
+        } else {
+            format!("{mantissa}e{exponent}")
+        }
+    } else if !(-3.0..6.0).contains(&magnitude) {
+        format!("{v:.1e}")
+    } else {
+        // Enough decimals for the value's magnitude, trailing zeros dropped.
+        let decimals = (3.0 - magnitude.floor()).clamp(0.0, 6.0) as usize;
+        let text = format!("{v:.decimals$}");
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
     }
 }
 
@@ -275,5 +226,25 @@ mod tests {
             ..chart
         };
         assert!(empty.to_svg().unwrap().starts_with("<svg"));
+    }
+
+    #[test]
+    fn log_axes_get_readable_ticks() {
+        let close = |a: Vec<f64>, b: &[f64]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-12 * y)
+        };
+        // Less than a decade: every digit.
+        assert!(close(log_ticks(1.5e-4, 4.5e-4), &[2e-4, 3e-4, 4e-4]));
+        // A few decades: 1, 2, 5.
+        assert!(close(
+            log_ticks(0.8, 60.0),
+            &[1.0, 2.0, 5.0, 10.0, 20.0, 50.0]
+        ));
+        assert_eq!(tick_label(3.0000000000000003e-4, true), "3e-4");
+        assert_eq!(tick_label(2e-4, true), "2e-4");
+        assert_eq!(tick_label(1e-5, true), "1e-5");
+        assert_eq!(tick_label(0.05, true), "0.05");
+        assert_eq!(tick_label(250.0, false), "250");
+        assert_eq!(tick_label(0.125, false), "0.125");
     }
 }
