@@ -33,6 +33,7 @@
 //! what lets linear elements run with USL where they inverted particles before.
 
 use nalgebra::SVector;
+use rayon::prelude::*;
 
 use crate::boundary::Boundary;
 use crate::settings::Damping;
@@ -144,8 +145,12 @@ impl<const D: usize> Grid<D> {
     /// Whether node `i` carries a velocity (see the module docs).
     #[inline]
     pub fn is_active(&self, i: usize, cancellation_fraction: f64) -> bool {
-        let m = self.mass[i].abs();
-        self.abs_mass[i] > self.round_off_mass && m > cancellation_fraction * self.abs_mass[i]
+        active_node(
+            self.mass[i],
+            self.abs_mass[i],
+            self.round_off_mass,
+            cancellation_fraction,
+        )
     }
 
     /// Velocities from momenta and forces, damping, boundary conditions.
@@ -174,44 +179,73 @@ impl<const D: usize> Grid<D> {
             // that overshoots every step (an inclined column crept down its walls).
             // Projecting the force before the update changes nothing else: the
             // velocity is projected after it anyway.
-            for i in 0..self.mass.len() {
-                let m = self.mass[i];
-                self.velocity[i] = if m != 0.0 {
-                    self.momentum[i] / m
-                } else {
-                    SVector::zeros()
-                };
-            }
+            self.velocity
+                .par_iter_mut()
+                .zip(self.mass.par_iter().zip(self.momentum.par_iter()))
+                .with_min_len(UPDATE_CHUNK)
+                .for_each(|(v, (&m, p))| {
+                    *v = if m != 0.0 { p / m } else { SVector::zeros() };
+                });
             boundary.apply(&mut self.velocity);
             boundary.apply(&mut self.force);
         }
-        for i in 0..self.mass.len() {
-            let m = self.mass[i];
-            if !self.is_active(i, cancellation_fraction) {
-                // A node with no mass at all can still carry a force (N = 0, ∇N ≠ 0).
-                report.dropped_mass += m;
-                report.redistributed_momentum += self.momentum[i] + self.force[i] * dt;
-                self.velocity[i] = SVector::zeros();
-                self.new_velocity[i] = SVector::zeros();
-                continue;
-            }
-            active_mass += m;
-            let v = self.momentum[i] / m;
-            let f = match damping {
-                Damping::Local { .. } => damped(self.force[i], self.velocity[i], m, damping),
-                _ => damped(self.force[i], v, m, damping),
-            };
-            let scaled_mass = dt * dt * modulus * self.stiffness[i];
-            self.velocity[i] = v;
-            if scaled_mass > m.abs() {
-                // Selective mass scaling: the node moves as if it had mass Δt² k, and the
-                // impulse it cannot absorb goes to the active nodes with the rest.
-                report.scaled_nodes += 1;
-                self.new_velocity[i] = v + f * (dt / scaled_mass.copysign(m));
-                report.redistributed_momentum += f * (dt * (1.0 - m.abs() / scaled_mass));
-            } else {
-                self.new_velocity[i] = v + f * (dt / m);
-            }
+        // In parallel over fixed chunks of nodes; the chunks' partial sums are added in
+        // chunk order, so the report does not depend on the thread count.
+        let round_off = self.round_off_mass;
+        let local_damping = matches!(damping, Damping::Local { .. });
+        let partials: Vec<(f64, SVector<f64, D>, usize, f64)> = self
+            .mass
+            .par_chunks(UPDATE_CHUNK)
+            .zip(self.abs_mass.par_chunks(UPDATE_CHUNK))
+            .zip(self.momentum.par_chunks(UPDATE_CHUNK))
+            .zip(self.force.par_chunks(UPDATE_CHUNK))
+            .zip(self.stiffness.par_chunks(UPDATE_CHUNK))
+            .zip(self.velocity.par_chunks_mut(UPDATE_CHUNK))
+            .zip(self.new_velocity.par_chunks_mut(UPDATE_CHUNK))
+            .map(
+                |((((((mass, abs_mass), momentum), force), stiffness), velocity), new_velocity)| {
+                    let (mut dropped, mut redistributed, mut scaled, mut active) =
+                        (0.0, SVector::<f64, D>::zeros(), 0usize, 0.0);
+                    for i in 0..mass.len() {
+                        let m = mass[i];
+                        if !active_node(m, abs_mass[i], round_off, cancellation_fraction) {
+                            // A node with no mass at all can still carry a force (N = 0,
+                            // ∇N ≠ 0).
+                            dropped += m;
+                            redistributed += momentum[i] + force[i] * dt;
+                            velocity[i] = SVector::zeros();
+                            new_velocity[i] = SVector::zeros();
+                            continue;
+                        }
+                        active += m;
+                        let v = momentum[i] / m;
+                        let f = if local_damping {
+                            damped(force[i], velocity[i], m, damping)
+                        } else {
+                            damped(force[i], v, m, damping)
+                        };
+                        let scaled_mass = dt * dt * modulus * stiffness[i];
+                        velocity[i] = v;
+                        if scaled_mass > m.abs() {
+                            // Selective mass scaling: the node moves as if it had mass
+                            // Δt² k, and the impulse it cannot absorb goes to the active
+                            // nodes with the rest.
+                            scaled += 1;
+                            new_velocity[i] = v + f * (dt / scaled_mass.copysign(m));
+                            redistributed += f * (dt * (1.0 - m.abs() / scaled_mass));
+                        } else {
+                            new_velocity[i] = v + f * (dt / m);
+                        }
+                    }
+                    (dropped, redistributed, scaled, active)
+                },
+            )
+            .collect();
+        for (dropped, redistributed, scaled, active) in partials {
+            report.dropped_mass += dropped;
+            report.redistributed_momentum += redistributed;
+            report.scaled_nodes += scaled;
+            active_mass += active;
         }
         // The impulse of empty nodes (a particle exactly on a facet gives the opposite
         // vertex N = 0 but ∇N ≠ 0, so a force and no mass) and what mass-scaled nodes
@@ -219,11 +253,16 @@ impl<const D: usize> Grid<D> {
         // stays conserved to round-off, and the amount is reported.
         if active_mass > 0.0 && report.redistributed_momentum.norm_squared() > 0.0 {
             let shift = report.redistributed_momentum / active_mass;
-            for i in 0..self.mass.len() {
-                if self.is_active(i, cancellation_fraction) {
-                    self.new_velocity[i] += shift;
-                }
-            }
+            let (mass, abs_mass) = (&self.mass, &self.abs_mass);
+            self.new_velocity
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(UPDATE_CHUNK)
+                .for_each(|(i, v)| {
+                    if active_node(mass[i], abs_mass[i], round_off, cancellation_fraction) {
+                        *v += shift;
+                    }
+                });
         }
         boundary.apply(&mut self.velocity);
         boundary.apply(&mut self.new_velocity);
@@ -232,6 +271,16 @@ impl<const D: usize> Grid<D> {
         }
         report
     }
+}
+
+/// Nodes per parallel work item of the grid update (fixed, so that the partial sums, and
+/// hence the report, do not depend on the thread count).
+const UPDATE_CHUNK: usize = 4096;
+
+/// Whether a node with mass `m` and Σ|N| m_p = `abs_mass` carries velocity: above the
+/// round-off mass, and not mostly cancelled by negative MLS values.
+fn active_node(m: f64, abs_mass: f64, round_off: f64, cancellation_fraction: f64) -> bool {
+    abs_mass > round_off && m.abs() > cancellation_fraction * abs_mass
 }
 
 /// The nodal force with damping against the node's velocity `v`.

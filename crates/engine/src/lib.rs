@@ -50,6 +50,7 @@ pub mod geostatic;
 mod grid;
 mod parallel;
 mod particles;
+mod scatter;
 mod seeding;
 mod settings;
 mod simulation;

@@ -22,37 +22,6 @@ use crate::transfer::{StressUpdate, TransferScheme};
 pub type BodyForce<const D: usize> =
     std::sync::Arc<dyn Fn(&SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync>;
 
-/// Particle blocks of the parallel P2G scatter: a fixed number, so that results do not
-/// depend on the thread count; more blocks than cores keeps the work balanced.
-const P2G_BLOCKS: usize = 8;
-
-/// Below this many particles the scatter runs as one block: resetting and reducing the
-/// per-block grid buffers would cost more than it saves.
-const P2G_PARALLEL_MIN: usize = 8192;
-
-/// One block's share of the nodal sums.
-#[derive(Default)]
-struct GridBuffer<const D: usize> {
-    mass: Vec<f64>,
-    abs_mass: Vec<f64>,
-    momentum: Vec<SVector<f64, D>>,
-    force: Vec<SVector<f64, D>>,
-    stiffness: Vec<f64>,
-}
-
-impl<const D: usize> GridBuffer<D> {
-    fn reset(&mut self, nodes: usize) {
-        for field in [&mut self.mass, &mut self.abs_mass, &mut self.stiffness] {
-            field.clear();
-            field.resize(nodes, 0.0);
-        }
-        for field in [&mut self.momentum, &mut self.force] {
-            field.clear();
-            field.resize(nodes, SVector::zeros());
-        }
-    }
-}
-
 /// What G2P computes for one particle.
 #[derive(Debug, Clone, Copy)]
 struct ParticleUpdate<const D: usize> {
@@ -117,7 +86,7 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     dt: f64,
     totals: Totals<D>,
     stencils: Stencils<D>,
-    blocks: Vec<GridBuffer<D>>,
+    scatter: crate::scatter::Scatter<D>,
     grid: Grid<D>,
     times: StageTimes,
     // Per-particle buffers the step reuses, so a step allocates nothing once they have
@@ -243,7 +212,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             time: 0.0,
             totals: Totals::default(),
             stencils: Stencils::default(),
-            blocks: Vec::new(),
+            scatter: Default::default(),
             times: StageTimes::default(),
             stress_buffer: Vec::new(),
             reactions: Default::default(),
@@ -570,80 +539,56 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         Ok(())
     }
 
-    /// P2G: the scatter in P2G_BLOCKS fixed particle blocks,
-    /// each into its own grid buffer, in parallel; buffers are summed per node in block
-    /// order. The split does not depend on the thread count, so neither do the sums.
+    /// P2G: every particle's mass, momentum and force to its stencil's nodes, through
+    /// [`crate::scatter::Scatter`] (parallel, bitwise independent of the thread count).
     fn particles_to_grid(&mut self) {
         let stresses = &self.stress_buffer;
         let p = &self.particles;
         let (stencils, kernel, time) = (&self.stencils, &self.kernel, self.time);
         let gravity = self.settings.gravity_at(time);
         let body_force = self.body_force.as_ref();
-        let block_count = if p.len() < P2G_PARALLEL_MIN {
-            1
-        } else {
-            P2G_BLOCKS
-        };
-        let block_len = p.len().div_ceil(block_count).max(1);
-        let nodes = self.grid.mass.len();
-        self.blocks.resize_with(block_count, GridBuffer::default);
-        self.blocks
-            .par_iter_mut()
-            .enumerate()
-            .for_each(|(block, buffer)| {
-                buffer.reset(nodes);
-                let end = ((block + 1) * block_len).min(p.len());
-                let start = (block * block_len).min(end);
-                for (i, stress) in stresses.iter().enumerate().take(end).skip(start) {
-                    let (m, v, x) = (p.mass[i], p.velocity[i], p.position[i]);
-                    let c = if T::AFFINE {
-                        limited_affine(&p.affine[i], p.affine_moment[i], stencils, i, kernel, &x)
-                    } else {
-                        SMatrix::zeros()
-                    };
-                    let volume = p.volume[i];
-                    let stress_volume = stress * volume;
-                    let acceleration =
-                        gravity + body_force.map_or(SVector::zeros(), |b| b(&x, time));
-                    let st = stencils.of(i);
-                    for e in 0..st.len() {
-                        let node = st.nodes[e] as usize;
-                        let n = st.values[e];
-                        let gradient = st.gradients[e];
-                        buffer.mass[node] += n * m;
-                        buffer.abs_mass[node] += n.abs() * m;
-                        buffer.stiffness[node] += volume * gradient.norm_squared();
-                        let mut mv = v;
-                        if T::AFFINE {
-                            mv += c * (kernel.node_position(node) - x);
-                        }
-                        buffer.momentum[node] += mv * (n * m);
-                        buffer.force[node] += acceleration * (n * m) - stress_volume * gradient;
-                    }
-                }
-            });
-        let blocks = &self.blocks;
         let g = &mut self.grid;
-        g.mass
-            .par_iter_mut()
-            .zip(g.abs_mass.par_iter_mut())
-            .zip(g.stiffness.par_iter_mut())
-            .zip(g.momentum.par_iter_mut())
-            .zip(g.force.par_iter_mut())
-            .enumerate()
-            .for_each(
-                |(node, ((((mass, abs_mass), stiffness), momentum), force))| {
-                    *mass = blocks.iter().map(|b| b.mass[node]).sum();
-                    *abs_mass = blocks.iter().map(|b| b.abs_mass[node]).sum();
-                    *stiffness = blocks.iter().map(|b| b.stiffness[node]).sum();
-                    *momentum = blocks
-                        .iter()
-                        .fold(SVector::zeros(), |acc, b| acc + b.momentum[node]);
-                    *force = blocks
-                        .iter()
-                        .fold(SVector::zeros(), |acc, b| acc + b.force[node]);
-                },
-            );
+        let sums = crate::scatter::NodalSums {
+            mass: &mut g.mass,
+            abs_mass: &mut g.abs_mass,
+            stiffness: &mut g.stiffness,
+            momentum: &mut g.momentum,
+            force: &mut g.force,
+        };
+        // With a constant second moment (B-splines) the affine energy cannot grow as a
+        // particle moves, and the limiter has nothing to do.
+        let varying_moment = kernel.constant_second_moment().is_none();
+        self.scatter.scatter(stencils, p.len(), sums, |i, window| {
+            let (m, v, x) = (p.mass[i], p.velocity[i], p.position[i]);
+            let c = match (T::AFFINE, varying_moment) {
+                (false, _) => SMatrix::zeros(),
+                (true, true) => {
+                    limited_affine(&p.affine[i], p.affine_moment[i], stencils, i, kernel, &x)
+                }
+                (true, false) => p.affine[i],
+            };
+            let volume = p.volume[i];
+            let stress_volume = stresses[i] * volume;
+            let acceleration = gravity + body_force.map_or(SVector::zeros(), |b| b(&x, time));
+            let st = stencils.of(i);
+            for e in 0..st.len() {
+                let node = st.nodes[e] as usize;
+                let n = st.values[e];
+                let gradient = st.gradients[e];
+                let mut mv = v;
+                if T::AFFINE {
+                    mv += c * (kernel.node_position(node) - x);
+                }
+                window.add(
+                    node,
+                    n * m,
+                    n.abs() * m,
+                    volume * gradient.norm_squared(),
+                    mv * (n * m),
+                    acceleration * (n * m) - stress_volume * gradient,
+                );
+            }
+        });
     }
 
     /// G2P: velocity, affine matrix, position, velocity gradient; then the walls. The
@@ -654,6 +599,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let positions = &self.particles.position;
         let velocities = &self.particles.velocity;
         let mut updates = std::mem::take(&mut self.updates);
+        let moment_scale = kernel.constant_second_moment();
+        let constant_moment = moment_scale.map(|s| SMatrix::<f64, D, D>::identity() * s);
         (0..self.particles.len())
             .into_par_iter()
             .with_min_len(crate::stencils::CHUNK)
@@ -663,7 +610,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 let mut flip = SVector::<f64, D>::zeros();
                 let mut grad_v = SMatrix::<f64, D, D>::zeros();
                 let mut b = SMatrix::<f64, D, D>::zeros();
-                let mut d = SMatrix::<f64, D, D>::zeros();
+                let mut d = constant_moment.unwrap_or_else(SMatrix::zeros);
                 let st = stencils.of(i);
                 for e in 0..st.len() {
                     let node = st.nodes[e] as usize;
@@ -671,15 +618,20 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     pic += new_v[node] * n;
                     flip += (new_v[node] - old_v[node]) * n;
                     grad_v += new_v[node] * st.gradients[e].transpose();
-                    if T::AFFINE {
+                    if T::AFFINE && (T::USES_MOMENTS || constant_moment.is_none()) {
                         let r = kernel.node_position(node) - x;
-                        d += r * r.transpose() * n;
+                        if constant_moment.is_none() {
+                            d += r * r.transpose() * n;
+                        }
                         if T::USES_MOMENTS {
                             b += new_v[node] * r.transpose() * n;
                         }
                     }
                 }
-                let affine = transfer.affine(&b, &d, &grad_v);
+                let affine = match moment_scale {
+                    Some(s) => transfer.affine_with_constant_moment(&b, s, &grad_v),
+                    None => transfer.affine(&b, &d, &grad_v),
+                };
                 ParticleUpdate {
                     velocity: transfer.velocity(&velocities[i], &pic, &flip),
                     position: x + pic * dt,
@@ -694,44 +646,76 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             })
             .collect_into_vec(&mut updates);
         let mut velocity_gradients = std::mem::take(&mut self.velocity_gradients);
-        velocity_gradients.clear();
+        velocity_gradients.resize(updates.len(), SMatrix::zeros());
         let p = &mut self.particles;
-        let gravity = self.settings.gravity_at(self.time);
+        let (gravity, time) = (self.settings.gravity_at(self.time), self.time);
         let body_force = self.body_force.as_ref();
-        // Work of gravity and body forces with the mean of old and new velocity: the
-        // trapezoidal rule balances the kinetic energy of a free fall exactly.
-        let mut power = 0.0;
-        // The longest move of the step (the position follows the PIC velocity, which for
-        // FLIP can differ from the stored one): the Courant check reads it.
-        let mut longest = (0, 0.0f64);
-        let marks = self
-            .boundary
+        let (boundary, kernel) = (&self.boundary, &self.kernel);
+        let marks = boundary
             .has_node_conditions()
-            .then(|| self.boundary.node_marks(self.grid.mass.len()));
-        for (i, update) in updates.iter().enumerate() {
-            let acceleration =
-                body_force.map_or(gravity, |b| gravity + b(&p.position[i], self.time));
-            power += p.mass[i] * acceleration.dot(&(p.velocity[i] + update.velocity)) * 0.5;
-            let moved = (update.position - p.position[i]).norm();
-            if moved > longest.1 {
-                longest = (i, moved);
-            }
-            p.velocity[i] = update.velocity;
-            p.position[i] = update.position;
-            p.affine[i] = update.affine;
-            p.affine_moment[i] = update.affine_moment;
-            if self.boundary.hold(&mut p.position[i], &mut p.velocity[i]) {
-                self.totals.wall_corrections += 1;
-            }
-            if let Some(marks) = &marks {
-                if let Some(exit) = self.kernel.domain_exit(&p.position[i], &p.cache[i]) {
-                    if Boundary::hold_at_facet(marks, &exit, &mut p.position[i], &mut p.velocity[i])
-                    {
-                        self.totals.wall_corrections += 1;
+            .then(|| boundary.node_marks(self.grid.mass.len()));
+        let chunk = crate::stencils::CHUNK;
+        // In parallel over fixed chunks; the partial sums are joined in chunk order.
+        let partials: Vec<(f64, (usize, f64), usize)> = p
+            .velocity
+            .par_chunks_mut(chunk)
+            .zip(p.position.par_chunks_mut(chunk))
+            .zip(p.affine.par_chunks_mut(chunk))
+            .zip(p.affine_moment.par_chunks_mut(chunk))
+            .zip(velocity_gradients.par_chunks_mut(chunk))
+            .zip(updates.par_chunks(chunk))
+            .enumerate()
+            .map(
+                |(c, (((((velocity, position), affine), moment), gradient), update))| {
+                    // Work of gravity and body forces with the mean of old and new velocity:
+                    // the trapezoidal rule balances the kinetic energy of a free fall exactly.
+                    let mut power = 0.0;
+                    // The longest move (the position follows the PIC velocity, which for FLIP
+                    // can differ from the stored one): the Courant check reads it.
+                    let mut longest = (0, 0.0f64);
+                    let mut corrections = 0;
+                    for k in 0..update.len() {
+                        let (i, u) = (c * chunk + k, &update[k]);
+                        let acceleration =
+                            body_force.map_or(gravity, |b| gravity + b(&position[k], time));
+                        power += p.mass[i] * acceleration.dot(&(velocity[k] + u.velocity)) * 0.5;
+                        let moved = (u.position - position[k]).norm();
+                        if moved > longest.1 {
+                            longest = (i, moved);
+                        }
+                        velocity[k] = u.velocity;
+                        position[k] = u.position;
+                        affine[k] = u.affine;
+                        moment[k] = u.affine_moment;
+                        gradient[k] = u.velocity_gradient;
+                        if boundary.hold(&mut position[k], &mut velocity[k]) {
+                            corrections += 1;
+                        }
+                        if let Some(marks) = &marks {
+                            if let Some(exit) = kernel.domain_exit(&position[k], &p.cache[i]) {
+                                if Boundary::hold_at_facet(
+                                    marks,
+                                    &exit,
+                                    &mut position[k],
+                                    &mut velocity[k],
+                                ) {
+                                    corrections += 1;
+                                }
+                            }
+                        }
                     }
-                }
+                    (power, longest, corrections)
+                },
+            )
+            .collect();
+        let mut power = 0.0;
+        let mut longest = (0, 0.0f64);
+        for (chunk_power, chunk_longest, corrections) in partials {
+            power += chunk_power;
+            if chunk_longest.1 > longest.1 {
+                longest = chunk_longest;
             }
-            velocity_gradients.push(update.velocity_gradient);
+            self.totals.wall_corrections += corrections;
         }
         self.totals.external_work += power * dt;
         self.totals.longest_move = longest;

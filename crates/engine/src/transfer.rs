@@ -38,6 +38,17 @@ pub trait TransferScheme: Copy + Send + Sync + std::fmt::Debug {
         let _ = (b, d, grad_v);
         SMatrix::zeros()
     }
+
+    /// [`Self::affine`] for a kernel whose second moment D_p is s·I everywhere
+    /// (`Kernel::constant_second_moment`); a scheme may skip inverting D_p.
+    fn affine_with_constant_moment<const D: usize>(
+        &self,
+        b: &SMatrix<f64, D, D>,
+        s: f64,
+        grad_v: &SMatrix<f64, D, D>,
+    ) -> SMatrix<f64, D, D> {
+        self.affine(b, &(SMatrix::identity() * s), grad_v)
+    }
 }
 
 /// Particle-in-cell: v_p = Σ N ṽ_i (dissipative, stable).
@@ -112,6 +123,16 @@ impl TransferScheme for Apic {
         }
         b * cholesky.inverse()
     }
+
+    fn affine_with_constant_moment<const D: usize>(
+        &self,
+        b: &SMatrix<f64, D, D>,
+        s: f64,
+        _: &SMatrix<f64, D, D>,
+    ) -> SMatrix<f64, D, D> {
+        // D_p = s I with s > 0 (a B-spline's variance): C_p = B_p / s, the closed form.
+        b / s
+    }
 }
 
 impl TransferScheme for VelocityGradientAffine {
@@ -171,6 +192,14 @@ mod tests {
             g3
         );
         assert_eq!(Pic.affine(&b, &d, &grad_v), Matrix2::zeros());
+        // A constant moment s I: the closed form equals the general inverse.
+        let s = 0.3;
+        let closed = Apic.affine_with_constant_moment(&b, s, &grad_v);
+        assert!((closed - Apic.affine(&b, &(Matrix2::identity() * s), &grad_v)).norm() < 1e-12);
+        assert_eq!(
+            VelocityGradientAffine.affine_with_constant_moment(&b, s, &grad_v),
+            grad_v
+        );
         assert_eq!(VelocityGradientAffine.affine(&b, &d, &grad_v), grad_v);
         let v = Flip { alpha: 0.75 }.velocity(
             &nalgebra::Vector2::new(1.0, 0.0),

@@ -79,8 +79,9 @@ fn state<const D: usize, K: Kernel<D> + Clone + Send + Sync>(
     })
 }
 
-/// The 8192 particles from which P2G scatters in parallel blocks.
-const PARALLEL_SCATTER: usize = 8192;
+/// The particles per P2G block: beyond this many, P2G scatters in several blocks in
+/// parallel and merges their windows.
+const PARALLEL_SCATTER: usize = 4096;
 
 /// Steps `kernel` in pools of 1, 2 and 4 threads; `parallel_scatter` says on which side
 /// of the P2G block threshold the particle count must lie.
@@ -122,7 +123,7 @@ fn two_dimensional_runs_are_bitwise_independent_of_the_thread_count() {
             .unwrap(),
     );
     assert_thread_independent("umls", Umls2::new(mesh), 0.004, 20, true);
-    // A jittered mesh, and few enough particles that P2G scatters serially while the
+    // A jittered mesh, and few enough particles that P2G scatters as one block while the
     // stencils, stresses and G2P still run in parallel.
     let jittered = Arc::new(
         Lattice::new([0.0, 0.0], [1.0, 1.0], [20, 20])

@@ -157,6 +157,15 @@ impl<const D: usize> Kernel<D> for BSplineKernel<D> {
         self.h
     }
 
+    fn constant_second_moment(&self) -> Option<f64> {
+        // The variance of the quadratic (cubic) B-spline is 1/4 (1/3) per axis, and the
+        // tensor product's cross terms vanish (each axis' first moment is zero).
+        Some(match self.order {
+            BSplineOrder::Quadratic => self.h * self.h / 4.0,
+            BSplineOrder::Cubic => self.h * self.h / 3.0,
+        })
+    }
+
     fn stencil(
         &self,
         x: &SVector<f64, D>,
@@ -236,5 +245,44 @@ mod tests {
         assert_eq!(grid.cells(), [12 + 4, 5 + 4]);
         assert!(BSplineKernel::covering(lower, upper, 0.0, BSplineOrder::Cubic).is_none());
         assert!(BSplineKernel::covering(lower, upper, f64::NAN, BSplineOrder::Cubic).is_none());
+    }
+    /// Node indices split into grid coordinates x fastest, for every node of a 3D grid
+    /// with awkward counts and for indices beyond 2³² in 2D.
+    #[test]
+    fn node_positions_match_integer_division() {
+        let grid = BSplineKernel::new(
+            nalgebra::Vector3::new(-0.3, 0.1, 2.0),
+            0.05,
+            [6, 12, 48],
+            BSplineOrder::Cubic,
+        )
+        .unwrap();
+        for node in 0..grid.node_count() {
+            let (i, j, k) = (node % 7, (node / 7) % 13, node / 91);
+            let expected = nalgebra::Vector3::new(
+                -0.3 + 0.05 * i as f64,
+                0.1 + 0.05 * j as f64,
+                2.0 + 0.05 * k as f64,
+            );
+            assert_eq!(grid.node_position(node), expected, "node {node}");
+        }
+        let wide = BSplineKernel::new(
+            Vector2::zeros(),
+            1.0,
+            [99_999, 40_000],
+            BSplineOrder::Quadratic,
+        )
+        .unwrap();
+        for node in [
+            0,
+            99_999,
+            100_000,
+            100_001,
+            4_000_099_999,
+            wide.node_count() - 1,
+        ] {
+            let expected = Vector2::new((node % 100_000) as f64, (node / 100_000) as f64);
+            assert_eq!(wide.node_position(node), expected, "node {node}");
+        }
     }
 }

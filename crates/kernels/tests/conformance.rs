@@ -27,11 +27,23 @@ fn conformance<const D: usize, K: Kernel<D>>(
         let grad_sum: SVector<f64, D> = st.gradients().iter().sum();
         let mut position = SVector::<f64, D>::zeros();
         let mut jacobian = SMatrix::<f64, D, D>::zeros();
+        let mut moment = SMatrix::<f64, D, D>::zeros();
         for (node, n, g) in st.iter() {
             prop_assert!((node as usize) < kernel.node_count());
             let xi = kernel.node_position(node as usize);
             position += xi * n;
             jacobian += xi * g.transpose();
+            moment += (xi - x) * (xi - x).transpose() * n;
+        }
+        // A kernel that declares its second moment constant must have that moment here.
+        if let Some(s) = kernel.constant_second_moment() {
+            let expected = SMatrix::<f64, D, D>::identity() * s;
+            prop_assert!(
+                (moment - expected).norm() < 1e-9 * s,
+                "Σ N r rᵀ = {} vs {} I",
+                moment,
+                s
+            );
         }
         let h = kernel.spacing();
         prop_assert!((sum - 1.0).abs() < 1e-12, "partition of unity {}", sum);

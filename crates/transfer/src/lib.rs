@@ -95,6 +95,14 @@ pub trait Kernel<const D: usize>: Send + Sync {
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError>;
 
+    /// The second moment Σ_i N_i(x) (x_i − x)(x_i − x)ᵀ where it is the same multiple
+    /// s·I of the identity at every x (s = h²/4 for quadratic, h²/3 for cubic B-splines),
+    /// so transfers can use it instead of summing it per particle; `None` (the default)
+    /// where it varies with x, as for every mesh kernel.
+    fn constant_second_moment(&self) -> Option<f64> {
+        None
+    }
+
     /// If `x` lies outside the domain, where it left it, seen from the location in
     /// `cache` (`None` inside, or where the kernel cannot tell). Mesh kernels use it to
     /// hold particles at walls given as boundary node sets. Default: `None`.
