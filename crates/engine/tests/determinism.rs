@@ -140,6 +140,52 @@ fn two_dimensional_runs_are_bitwise_independent_of_the_thread_count() {
     );
 }
 
+/// A mesh numbered without locality: every P2G window spans most of the nodes, so the
+/// scatter merges neighbouring blocks until the windows span at most 4× the node count.
+/// The result still does not depend on the thread count, and it is the run on the
+/// well-numbered mesh up to round-off (only the order of the sums differs).
+#[test]
+fn a_scrambled_numbering_changes_only_the_summation_order() {
+    let ordered = Lattice::new([0.0, 0.0], [1.0, 1.0], [40, 40])
+        .triangles(Diagonal::Alternating)
+        .unwrap();
+    // Vertex k of the ordered mesh becomes vertex perm[k] (a fixed pseudo-random order).
+    let n = ordered.vertices().len();
+    let mut perm: Vec<u32> = (0..n as u32).collect();
+    let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+    for i in (1..n).rev() {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        perm.swap(i, (seed % (i as u64 + 1)) as usize);
+    }
+    let mut vertices = vec![Vector2::zeros(); n];
+    for (k, v) in ordered.vertices().iter().enumerate() {
+        vertices[perm[k] as usize] = *v;
+    }
+    let simplices: Vec<u32> = ordered
+        .simplices()
+        .flat_map(|s| s.iter().map(|&v| perm[v as usize]).collect::<Vec<_>>())
+        .collect();
+    let scrambled =
+        umls_mesh::SimplexMesh::new(vertices, simplices, umls_mesh::Orientation::Fix).unwrap();
+    let h = 0.002;
+    assert!(particles::<2, ()>(h).len() > 8 * PARALLEL_SCATTER);
+    assert_thread_independent(
+        "umls, scrambled",
+        Umls2::new(Arc::new(scrambled.clone())),
+        h,
+        3,
+        true,
+    );
+    let a = state(&Umls2::new(Arc::new(ordered)), h, 3, 2);
+    let b = state(&Umls2::new(Arc::new(scrambled)), h, 3, 2);
+    let largest = a.1.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    for (va, vb) in a.1.iter().zip(&b.1) {
+        assert!((va - vb).norm() <= 1e-12 * largest, "{va} vs {vb}");
+    }
+}
+
 #[test]
 fn three_dimensional_runs_are_bitwise_independent_of_the_thread_count() {
     let mesh = Arc::new(
