@@ -236,10 +236,18 @@ impl NeighbourIndex {
     }
 
     fn nearest_projected(&self, y: &[f64], k: NonZero<usize>) -> Vec<usize> {
+        self.nearest_projected_with_distances(y, k)
+            .into_iter()
+            .map(|(item, _)| item)
+            .collect()
+    }
+
+    /// The `k` nearest in the tree's coordinates, with their squared distances there.
+    fn nearest_projected_with_distances(&self, y: &[f64], k: NonZero<usize>) -> Vec<(usize, f64)> {
         with_tree!(&self.tree, tree, q = y => tree
             .nearest_n::<SquaredEuclidean>(&q, k)
             .into_iter()
-            .map(|n| n.item as usize)
+            .map(|n| (n.item as usize, n.distance))
             .collect())
     }
 
@@ -289,13 +297,24 @@ impl NeighbourIndex {
             SearchStrategy::ProjectedTree => {
                 let y = project(self.projection.as_ref(), query, self.dim());
                 // Every true k-nearest neighbour is within the k-th candidate's true
-                // distance, and projection never lengthens a distance.
-                let bound = self
-                    .nearest_projected(&y, k)
+                // distance, and projection never lengthens a distance. The tree search
+                // reaches at least as far as the candidates' projected distances too: in
+                // round-off a projected distance can exceed the true one (a query on a
+                // sample has true distance 0 and projected distance 1e-30), and the
+                // candidates themselves must not be lost.
+                let (bound, reach) = self
+                    .nearest_projected_with_distances(&y, k)
                     .into_iter()
-                    .map(|item| distance_squared(cloud.point(self.sample(item)), query))
-                    .fold(0.0, f64::max);
-                let items = self.within_projected(&y, bound * (1.0 + 1e-12));
+                    .map(|(item, projected)| {
+                        (
+                            distance_squared(cloud.point(self.sample(item)), query),
+                            projected,
+                        )
+                    })
+                    .fold((0.0, 0.0), |(b, r), (d, p)| {
+                        (f64::max(b, d), f64::max(r, p))
+                    });
+                let items = self.within_projected(&y, bound.max(reach) * (1.0 + 1e-12));
                 self.push_exact(cloud, query, items, bound * (1.0 + 1e-12), found);
             }
             SearchStrategy::Scan => self.scan_nearest(cloud, query, k.get(), found),
@@ -330,7 +349,11 @@ impl NeighbourIndex {
             }
             _ => {
                 let y = project(self.projection.as_ref(), query, self.dim());
-                let items = self.within_projected(&y, r2);
+                // The tree search gets an absolute slack of the projection's round-off,
+                // so a sample at (or within round-off of) the radius is not lost to it;
+                // the exact distances decide.
+                let slack = (1e-13 * y.iter().map(|c| c * c).sum::<f64>().sqrt()).powi(2);
+                let items = self.within_projected(&y, r2 + slack);
                 self.push_exact(cloud, query, items, r2, found);
             }
         }

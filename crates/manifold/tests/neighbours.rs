@@ -3,7 +3,9 @@
 //! including duplicate samples and data on a coordinate plane.
 
 use proptest::prelude::*;
-use umls_manifold::{NeighbourIndex, PointCloud};
+use umls_manifold::{ManifoldMls, NeighbourIndex, PointCloud, Settings};
+
+mod common;
 
 fn brute(cloud: &PointCloud, q: &[f64]) -> Vec<(usize, f64)> {
     let mut all: Vec<(usize, f64)> = (0..cloud.len())
@@ -85,4 +87,51 @@ fn duplicates_and_flat_data() {
         }
     }
     check(3, coords, &[0.5, 0.5, 0.0, 0.1, 0.9, 0.3], 150).unwrap();
+}
+
+/// Queries on samples, and a few units in the last place off them, in high dimension
+/// (the projected tree): the true distance is 0 or ~1e-15, below the round-off of the
+/// projected one, and the sample must still be found by k-NN and by a radius query, and
+/// a manifold fit there must run. (In the benchmark, the helix in R¹⁰⁰⁰, a fit's
+/// projected point that close to a sample found no neighbour and panicked.)
+#[test]
+fn queries_on_samples_find_them_in_high_dimension() {
+    let n = 1000;
+    let columns = common::isometric_embedding(n, 17);
+    let helix = |t: f64| [t.cos(), t.sin(), 0.5 * t];
+    let samples: Vec<[f64; 3]> = (0..4000).map(|i| helix(12.0 * i as f64 / 4000.0)).collect();
+    let coords: Vec<f64> = samples
+        .iter()
+        .flat_map(|p| common::embed(&columns, p))
+        .collect();
+    let values: Vec<f64> = samples.iter().map(|p| p[0] * p[1] + p[2]).collect();
+    let cloud = PointCloud::new(n, coords, 1, values).unwrap();
+    let index = NeighbourIndex::new(&cloud);
+    for sample in (0..4000).step_by(37) {
+        // On the sample, and a few units in the last place off it: true distances of
+        // 0 and ~1e-15, below the projection's round-off.
+        let exact = cloud.point(sample).to_vec();
+        let nudged: Vec<f64> = exact
+            .iter()
+            .enumerate()
+            .map(|(j, &x)| {
+                if j % 3 == 0 {
+                    x.next_up()
+                } else {
+                    x.next_down()
+                }
+            })
+            .collect();
+        for q in [exact, nudged] {
+            let nearest = index.nearest(&cloud, &q, 1).unwrap();
+            assert_eq!(nearest.len(), 1, "sample {sample}");
+            assert!(nearest[0].distance <= 1e-12, "sample {sample}");
+            let within = index.within(&cloud, &q, 1e-12).unwrap();
+            assert!(within.iter().any(|f| f.index == sample), "sample {sample}");
+        }
+    }
+    let mls = ManifoldMls::new(cloud, Settings::new(1, 1)).unwrap();
+    let on_sample = common::embed(&columns, &helix(0.0));
+    let fit = mls.evaluate(&on_sample).unwrap();
+    assert!(fit.value[0].abs() < 1e-6, "{}", fit.value[0]);
 }

@@ -279,10 +279,7 @@ impl Document {
         }
         self.line("## Speed against accuracy, and convergence\n");
         for study in &matrix.accuracy {
-            let runs: Vec<&Record> = records
-                .iter()
-                .filter(|r| r.study == study.common.name)
-                .collect();
+            let runs = of_study(records, &study.common.name);
             self.line(format!("### {}\n", study.common.title));
             self.line(format!(
                 "Scene `{}`, metric `{}` ({}), refinement {:?} of h = {}.\n",
@@ -382,10 +379,7 @@ impl Document {
         }
         self.line("## Stability maps\n");
         for study in &matrix.stability {
-            let runs: Vec<&Record> = records
-                .iter()
-                .filter(|r| r.study == study.common.name)
-                .collect();
+            let runs = of_study(records, &study.common.name);
             self.line(format!("### {}\n", study.common.title));
             self.line(format!(
                 "Scene `{}`; columns: {} (`{}`), rows: {} (`{}`). Green: completed, the energy never \
@@ -484,10 +478,7 @@ impl Document {
                 ));
             }
             self.line("");
-            let runs: Vec<&Record> = records
-                .iter()
-                .filter(|r| r.study == study.common.name)
-                .collect();
+            let runs = of_study(records, &study.common.name);
             self.failures(&runs);
         }
         Ok(())
@@ -499,10 +490,7 @@ impl Document {
         }
         self.line("## Throughput\n");
         for study in &matrix.throughput {
-            let runs: Vec<&Record> = records
-                .iter()
-                .filter(|r| r.study == study.common.name)
-                .collect();
+            let runs = of_study(records, &study.common.name);
             self.line(format!("### {}\n", study.common.title));
             self.line(format!(
                 "Scene `{}`, threads {:?}, refinement {:?}.\n",
@@ -613,6 +601,11 @@ impl Document {
         self.line("- [`results.json`](results.json): the same with the host and the matrix name.");
         self.line("- `histories/`: the charted history columns, one CSV per run.");
     }
+}
+
+/// The records of one study, in run order.
+fn of_study<'a>(records: &'a [Record], study: &str) -> Vec<&'a Record> {
+    records.iter().filter(|r| r.study == study).collect()
 }
 
 fn status_text(r: &Record) -> String {
