@@ -66,13 +66,15 @@ fn ci() -> Result<(), String> {
         "warnings",
     ])?;
     // Crates must also build with default features off (the MLS core without the mesh,
-    // the mesh without parry).
+    // the mesh without parry, the B-spline kernels without either).
     cargo(&[
         "check",
         "-p",
         "umls-mesh",
         "-p",
         "umls-mls",
+        "-p",
+        "umls-kernels",
         "--no-default-features",
         "--release",
     ])?;

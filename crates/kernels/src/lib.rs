@@ -1,15 +1,17 @@
 //! MPM shape-function kernels behind the [`umls_transfer::Kernel`] port:
 //!
-//! - [`UmlsMeshKernel`] ([`Umls1`], [`Umls2`], [`Umls3`]): the C¹ UMLS kernel on a
-//!   simplicial mesh (umls-mls + umls-mesh);
-//! - [`LinearFeKernel`]: P1 hat functions on the same mesh, the classic unstructured MPM
-//!   with cell-crossing error;
+//! - `UmlsMeshKernel` (`Umls1`, `Umls2`, `Umls3`): the C¹ UMLS kernel on a
+//!   simplicial mesh (umls-mls + umls-mesh; feature `mesh`, on by default);
+//! - `LinearFeKernel`: P1 hat functions on the same mesh, the classic unstructured MPM
+//!   with cell-crossing error (feature `mesh`);
 //! - [`BSplineKernel`]: quadratic or cubic B-splines on a Cartesian grid, the
-//!   structured-grid reference.
+//!   structured-grid reference (always; with `default-features = false` the crate is
+//!   this alone, without the mesh crate and parry).
 //!
-//! Every kernel passes the same conformance suite (`tests/conformance.rs`): partition of
-//! unity, linear reproduction of values and gradients, valid node indices, and
-//! cache-independence. Swapping kernels in a study is a change of one type:
+//! Every kernel passes the same conformance suite (`testing::check_kernel`, public with
+//! the feature `testing` so that a kernel written elsewhere can run it too): partition
+//! of unity, linear reproduction of values and gradients, the declared second moment,
+//! valid node indices, and cache-independence. Swapping kernels in a study is a change of one type:
 //!
 //! ```
 //! use std::sync::Arc;
@@ -31,7 +33,12 @@
 //! ```
 
 mod bspline;
+#[cfg(feature = "mesh")]
 mod mesh_kernels;
 
+#[cfg(feature = "testing")]
+pub mod testing;
+
 pub use bspline::{BSplineKernel, BSplineOrder};
+#[cfg(feature = "mesh")]
 pub use mesh_kernels::{HostCache, LinearFeKernel, Umls1, Umls2, Umls3, UmlsMeshKernel};

@@ -4,75 +4,27 @@
 
 use std::sync::Arc;
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SVector;
 use proptest::prelude::*;
+use umls_kernels::testing::check_kernel;
 use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, Umls1, Umls2, Umls3};
 use umls_mesh::generate::{Diagonal, Lattice};
-use umls_transfer::{Kernel, KernelError, Stencil};
+use umls_transfer::{Kernel, Stencil};
 
-/// Runs the suite on points given as fractions of the box [lo, hi].
+/// Runs the public suite (`umls_kernels::testing`) on points given as fractions of the
+/// box [lo, hi].
 fn conformance<const D: usize, K: Kernel<D>>(
     kernel: &K,
     lo: SVector<f64, D>,
     hi: SVector<f64, D>,
     fractions: &[f64],
 ) -> Result<(), TestCaseError> {
-    let mut cache = K::Cache::default();
-    let mut st = Stencil::new();
-    let mut fresh = Stencil::new();
-    for chunk in fractions.chunks_exact(D) {
-        let x = lo + SVector::<f64, D>::from_fn(|k, _| chunk[k] * (hi[k] - lo[k]));
-        kernel.stencil(&x, &mut cache, &mut st).unwrap();
-        let sum: f64 = st.values().iter().sum();
-        let grad_sum: SVector<f64, D> = st.gradients().iter().sum();
-        let mut position = SVector::<f64, D>::zeros();
-        let mut jacobian = SMatrix::<f64, D, D>::zeros();
-        let mut moment = SMatrix::<f64, D, D>::zeros();
-        for (node, n, g) in st.iter() {
-            prop_assert!((node as usize) < kernel.node_count());
-            let xi = kernel.node_position(node as usize);
-            position += xi * n;
-            jacobian += xi * g.transpose();
-            moment += (xi - x) * (xi - x).transpose() * n;
-        }
-        // A kernel that declares its second moment constant must have that moment here.
-        if let Some(s) = kernel.constant_second_moment() {
-            let expected = SMatrix::<f64, D, D>::identity() * s;
-            prop_assert!(
-                (moment - expected).norm() < 1e-9 * s,
-                "Σ N r rᵀ = {} vs {} I",
-                moment,
-                s
-            );
-        }
-        let h = kernel.spacing();
-        prop_assert!((sum - 1.0).abs() < 1e-12, "partition of unity {}", sum);
-        prop_assert!(grad_sum.norm() * h < 1e-10, "Σ∇N = {:?}", grad_sum);
-        prop_assert!(
-            (position - x).norm() < 1e-12 * (1.0 + x.norm()),
-            "Σ N x = {:?} vs {:?}",
-            position,
-            x
-        );
-        prop_assert!(
-            (jacobian - SMatrix::<f64, D, D>::identity()).norm() < 1e-9,
-            "Σ x ∇Nᵀ = {}",
-            jacobian
-        );
-        // The cache only speeds location up: a fresh cache gives the same stencil.
-        kernel
-            .stencil(&x, &mut K::Cache::default(), &mut fresh)
-            .unwrap();
-        prop_assert_eq!(st.nodes(), fresh.nodes());
-        prop_assert_eq!(st.values(), fresh.values());
-    }
+    let points: Vec<SVector<f64, D>> = fractions
+        .chunks_exact(D)
+        .map(|c| lo + SVector::<f64, D>::from_fn(|k, _| c[k] * (hi[k] - lo[k])))
+        .collect();
     let outside = hi + SVector::<f64, D>::repeat(10.0 * kernel.spacing() + 1.0);
-    let outside_error = matches!(
-        kernel.stencil(&outside, &mut K::Cache::default(), &mut st),
-        Err(KernelError::OutsideDomain { .. })
-    );
-    prop_assert!(outside_error);
-    Ok(())
+    check_kernel(kernel, &points, outside).map_err(|v| TestCaseError::fail(v.to_string()))
 }
 
 fn fractions(d: usize) -> impl Strategy<Value = Vec<f64>> {
@@ -160,4 +112,80 @@ fn bspline_gradients_and_sizes() {
     }
     assert!(BSplineKernel::new(SVector::from([0.0]), -1.0, [10], BSplineOrder::Cubic).is_none());
     assert!(BSplineKernel::new(SVector::from([0.0]), 1.0, [2], BSplineOrder::Cubic).is_none());
+}
+
+/// The suite catches what it checks: hat functions on [0, 1] pass it; scaled values, a
+/// wrong declared second moment, a node beyond the count, and no error outside each fail
+/// it with the property named.
+#[test]
+fn the_public_suite_catches_broken_kernels() {
+    #[derive(Clone, Copy)]
+    struct Hat {
+        scale: f64,
+        moment: Option<f64>,
+        node_count: usize,
+        rejects_outside: bool,
+    }
+    impl Kernel<1> for Hat {
+        type Cache = ();
+        fn node_count(&self) -> usize {
+            self.node_count
+        }
+        fn node_position(&self, node: usize) -> SVector<f64, 1> {
+            SVector::from([node as f64])
+        }
+        fn spacing(&self) -> f64 {
+            1.0
+        }
+        fn constant_second_moment(&self) -> Option<f64> {
+            self.moment
+        }
+        fn stencil(
+            &self,
+            x: &SVector<f64, 1>,
+            _: &mut (),
+            out: &mut Stencil<1>,
+        ) -> Result<(), umls_transfer::KernelError> {
+            if self.rejects_outside && !(0.0..=1.0).contains(&x[0]) {
+                return Err(umls_transfer::KernelError::OutsideDomain { point: vec![x[0]] });
+            }
+            out.clear();
+            out.push(0, self.scale * (1.0 - x[0]), SVector::from([-1.0]))?;
+            out.push(1, self.scale * x[0], SVector::from([1.0]))?;
+            Ok(())
+        }
+    }
+    let good = Hat {
+        scale: 1.0,
+        moment: None,
+        node_count: 2,
+        rejects_outside: true,
+    };
+    let points = [SVector::from([0.25]), SVector::from([0.6])];
+    let outside = SVector::from([3.0]);
+    check_kernel(&good, &points, outside).unwrap();
+    let failure = |k: Hat| check_kernel(&k, &points, outside).unwrap_err().message;
+    assert!(failure(Hat { scale: 1.1, ..good }).contains("Σ N"));
+    // x(1 − x) ≠ 0.3 at x = 0.25: a hat's second moment is not constant.
+    assert!(
+        failure(Hat {
+            moment: Some(0.3),
+            ..good
+        })
+        .contains("declared")
+    );
+    assert!(
+        failure(Hat {
+            node_count: 1,
+            ..good
+        })
+        .contains("beyond")
+    );
+    assert!(
+        failure(Hat {
+            rejects_outside: false,
+            ..good
+        })
+        .contains("outside")
+    );
 }

@@ -50,6 +50,8 @@ mod locate;
 mod mesh;
 mod quality;
 mod sampling;
+#[cfg(feature = "proptest")]
+pub mod strategies;
 mod topology;
 
 pub use barycentric::{Barycentric, BarycentricGradients, MAX_SIMPLEX_VERTICES};

@@ -1,6 +1,6 @@
 //! Barycentric coordinates and point location against brute force.
 
-mod common;
+use umls_mesh::strategies as common;
 
 use nalgebra::SVector;
 use proptest::prelude::*;

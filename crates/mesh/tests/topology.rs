@@ -1,6 +1,6 @@
 //! Topology invariants on random jittered, rotated meshes in 1D, 2D and 3D.
 
-mod common;
+use umls_mesh::strategies as common;
 
 use std::collections::HashMap;
 

@@ -1,9 +1,23 @@
-//! Random jittered, rotated meshes shared by the property tests.
-#![allow(dead_code)]
+//! Proptest strategies for random valid meshes (feature `proptest`): graded, jittered
+//! intervals; jittered, rotated rectangles with any split pattern; jittered, rotated box
+//! tetrahedralisations. The crate's property tests use them, and so can any crate that
+//! tests code on meshes:
+//!
+//! ```
+//! use proptest::prelude::*;
+//! use umls_mesh::strategies;
+//!
+//! proptest!(|(mesh in strategies::rectangle())| {
+//!     let area: f64 = (0..mesh.simplex_count()).map(|s| mesh.volume(s)).sum();
+//!     // The rectangle [0, 2] × [0, 1], turned and jittered inside: its area stays 2.
+//!     prop_assert!((area - 2.0).abs() < 1e-9);
+//! });
+//! ```
 
 use proptest::prelude::*;
-use umls_mesh::SimplexMesh;
-use umls_mesh::generate::{Diagonal, Lattice, MAX_JITTER, Spacing};
+
+use crate::SimplexMesh;
+use crate::generate::{Diagonal, Lattice, MAX_JITTER, Spacing};
 
 /// Random graded, jittered interval meshes.
 pub fn interval() -> impl Strategy<Value = SimplexMesh<1>> {

@@ -1,0 +1,112 @@
+//! The conformance suite every kernel of the crate passes, public (feature `testing`) so
+//! that a kernel written elsewhere can be held to the same properties before it joins
+//! a comparison:
+//!
+//! - partition of unity Σ N_i = 1 and Σ ∇N_i = 0;
+//! - linear reproduction of positions Σ N_i x_i = x and gradients Σ x_i ∇N_iᵀ = I;
+//! - the second moment the kernel declares (`Kernel::constant_second_moment`), if any;
+//! - node indices below `node_count`;
+//! - the same stencil from a fresh location cache as from a warm one;
+//! - a typed `KernelError::OutsideDomain` far outside.
+//!
+//! ```
+//! use nalgebra::SVector;
+//! use umls_kernels::{BSplineKernel, BSplineOrder, testing::check_kernel};
+//!
+//! let grid = BSplineKernel::new(SVector::from([0.0, 0.0]), 0.25, [8, 8], BSplineOrder::Cubic).unwrap();
+//! let points = [SVector::from([0.7, 1.1]), SVector::from([1.3, 0.4])];
+//! check_kernel(&grid, &points, SVector::from([5.0, 5.0])).expect("a conforming kernel");
+//! ```
+
+use nalgebra::{SMatrix, SVector};
+use umls_transfer::{Kernel, KernelError, Stencil};
+
+/// Tolerances of the suite, relative to the kernel's spacing where lengths enter.
+const UNITY: f64 = 1e-12;
+const REPRODUCTION: f64 = 1e-9;
+
+/// Which property failed, where, and by how much.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Violation {
+    /// The point (empty for the outside check).
+    pub point: Vec<f64>,
+    /// What failed, with the values.
+    pub message: String,
+}
+
+impl std::fmt::Display for Violation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "at {:?}: {}", self.point, self.message)
+    }
+}
+
+impl std::error::Error for Violation {}
+
+/// Checks `kernel` at each of `points` (which must lie in its domain) and that
+/// `outside` is reported as outside the domain.
+pub fn check_kernel<const D: usize, K: Kernel<D>>(
+    kernel: &K,
+    points: &[SVector<f64, D>],
+    outside: SVector<f64, D>,
+) -> Result<(), Violation> {
+    let mut cache = K::Cache::default();
+    let (mut st, mut fresh) = (Stencil::new(), Stencil::new());
+    let h = kernel.spacing();
+    for x in points {
+        let fail = |message: String| Violation {
+            point: x.iter().copied().collect(),
+            message,
+        };
+        kernel
+            .stencil(x, &mut cache, &mut st)
+            .map_err(|e| fail(format!("no stencil inside the domain: {e}")))?;
+        let (mut sum, mut grad_sum) = (0.0, SVector::<f64, D>::zeros());
+        let mut position = SVector::<f64, D>::zeros();
+        let mut jacobian = SMatrix::<f64, D, D>::zeros();
+        let mut moment = SMatrix::<f64, D, D>::zeros();
+        for (node, n, g) in st.iter() {
+            if node as usize >= kernel.node_count() {
+                return Err(fail(format!(
+                    "node {node} beyond the {} nodes",
+                    kernel.node_count()
+                )));
+            }
+            let xi = kernel.node_position(node as usize);
+            sum += n;
+            grad_sum += g;
+            position += xi * n;
+            jacobian += xi * g.transpose();
+            moment += (xi - x) * (xi - x).transpose() * n;
+        }
+        if (sum - 1.0).abs() >= UNITY {
+            return Err(fail(format!("Σ N = {sum}, not 1")));
+        }
+        if grad_sum.norm() * h >= 100.0 * UNITY {
+            return Err(fail(format!("Σ ∇N = {grad_sum:?}, not 0")));
+        }
+        if (position - x).norm() >= UNITY * (1.0 + x.norm()) {
+            return Err(fail(format!("Σ N x_i = {position:?}, not x")));
+        }
+        if (jacobian - SMatrix::<f64, D, D>::identity()).norm() >= REPRODUCTION {
+            return Err(fail(format!("Σ x_i ∇N_iᵀ = {jacobian}, not I")));
+        }
+        if let Some(s) = kernel.constant_second_moment() {
+            if (moment - SMatrix::<f64, D, D>::identity() * s).norm() >= REPRODUCTION * s {
+                return Err(fail(format!("Σ N r rᵀ = {moment}, not the declared {s} I")));
+            }
+        }
+        kernel
+            .stencil(x, &mut K::Cache::default(), &mut fresh)
+            .map_err(|e| fail(format!("no stencil from a fresh cache: {e}")))?;
+        if st.nodes() != fresh.nodes() || st.values() != fresh.values() {
+            return Err(fail("a fresh cache gives another stencil".into()));
+        }
+    }
+    match kernel.stencil(&outside, &mut K::Cache::default(), &mut st) {
+        Err(KernelError::OutsideDomain { .. }) => Ok(()),
+        other => Err(Violation {
+            point: outside.iter().copied().collect(),
+            message: format!("expected an outside-the-domain error, got {other:?}"),
+        }),
+    }
+}
