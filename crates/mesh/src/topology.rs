@@ -1,14 +1,15 @@
 //! Mesh topology, computed once at construction: adjacency, incidence, face
 //! neighbours, boundary facets and the 1-rings the UMLS kernel needs.
 
-use std::collections::HashMap;
-use std::collections::hash_map::Entry;
-
 use nalgebra::{SMatrix, SVector};
+use rayon::prelude::*;
 
 use crate::csr::Csr;
 use crate::error::MeshError;
 use crate::mesh::{NO_NEIGHBOR, SimplexMesh};
+
+/// Vertices (or simplices) per parallel work item of the construction.
+const ROW_CHUNK: usize = 2048;
 
 /// A facet on the boundary of the mesh (a facet with exactly one incident simplex).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,46 +72,98 @@ impl<const D: usize> Topology<D> {
         let stride = D + 1;
         let n_simplices = simplices.len() / stride;
 
-        // Incidence and adjacency from the simplices' vertex lists.
-        let mut incidence: Vec<Vec<u32>> = vec![Vec::new(); vertex_count];
-        let mut adjacent: Vec<Vec<u32>> = vec![Vec::new(); vertex_count];
-        for (s, verts) in simplices.chunks_exact(stride).enumerate() {
-            for &a in verts {
-                incidence[a as usize].push(s as u32);
-                adjacent[a as usize].extend(verts.iter().copied().filter(|&b| b != a));
-            }
-        }
-        for row in &mut adjacent {
-            row.sort_unstable();
-            row.dedup();
-        }
-        let vertex_simplices = Csr::from_rows(incidence);
-        let adjacency = Csr::from_rows(adjacent);
-
-        // Face neighbours by matching facet keys; a third holder of a facet is an error.
-        let mut neighbors = vec![NO_NEIGHBOR; simplices.len()];
-        let mut facets: HashMap<[u32; 3], (u32, u8, bool)> =
-            HashMap::with_capacity(n_simplices * stride);
-        for (s, verts) in simplices.chunks_exact(stride).enumerate() {
-            for local in 0..stride {
-                let key = SimplexMesh::<D>::facet_key(verts, local);
-                match facets.entry(key) {
-                    Entry::Vacant(slot) => {
-                        slot.insert((s as u32, local as u8, false));
-                    }
-                    Entry::Occupied(mut slot) => {
-                        let (t, t_local, paired) = *slot.get();
-                        let t_slot = t as usize * stride + t_local as usize;
-                        if paired {
-                            return Err(non_manifold(key, t, neighbors[t_slot], s));
+        // Incidence and adjacency as sorted (vertex, other) pairs: sorting in parallel
+        // and cutting into rows replaces a vector per vertex.
+        let mut incidence: Vec<(u32, u32)> = simplices
+            .par_chunks_exact(stride)
+            .enumerate()
+            .flat_map_iter(|(s, verts)| verts.iter().map(move |&v| (v, s as u32)))
+            .collect();
+        incidence.par_sort_unstable();
+        let vertex_simplices =
+            Csr::from_sorted_pairs(vertex_count, &incidence, "vertex-simplex incidences")?;
+        drop(incidence);
+        // Each vertex's neighbours: the other vertices of its simplices, per vertex in
+        // parallel chunks.
+        let adjacency = {
+            let chunks: Vec<(Vec<usize>, Vec<u32>)> = (0..vertex_count)
+                .collect::<Vec<_>>()
+                .par_chunks(ROW_CHUNK)
+                .map(|chunk| {
+                    let (mut lengths, mut values) = (Vec::with_capacity(chunk.len()), Vec::new());
+                    let mut row = Vec::new();
+                    for &v in chunk {
+                        row.clear();
+                        for &s in vertex_simplices.row(v) {
+                            let verts = &simplices[s as usize * stride..][..stride];
+                            row.extend(verts.iter().copied().filter(|&w| w as usize != v));
                         }
-                        neighbors[t_slot] = s as u32;
-                        neighbors[s * stride + local] = t;
-                        slot.get_mut().2 = true;
+                        row.sort_unstable();
+                        row.dedup();
+                        lengths.push(row.len());
+                        values.extend_from_slice(&row);
+                    }
+                    (lengths, values)
+                })
+                .collect();
+            let total = chunks.iter().map(|c| c.1.len()).sum();
+            let mut values = Vec::with_capacity(total);
+            for (_, v) in &chunks {
+                values.extend_from_slice(v);
+            }
+            Csr::from_lengths(
+                chunks.iter().flat_map(|c| c.0.iter().copied()),
+                values,
+                "vertex adjacencies",
+            )?
+        };
+
+        // Face neighbours: every facet's key with its slot (simplex · stride + local),
+        // sorted, so the holders of one facet are neighbours in the list. A third holder
+        // is an error; of several, the one a pass in simplex order meets first (the
+        // smallest third slot) is reported, whatever the thread count.
+        let mut facets: Vec<([u32; 3], u32)> = (0..n_simplices * stride)
+            .into_par_iter()
+            .map(|slot| {
+                let verts = &simplices[slot / stride * stride..][..stride];
+                (
+                    SimplexMesh::<D>::facet_key(verts, slot % stride),
+                    slot as u32,
+                )
+            })
+            .collect();
+        facets.par_sort_unstable();
+        let mut neighbors = vec![NO_NEIGHBOR; simplices.len()];
+        let mut non_manifold_at: Option<(u32, MeshError)> = None;
+        let mut i = 0;
+        while i < facets.len() {
+            let key = facets[i].0;
+            let mut j = i + 1;
+            while j < facets.len() && facets[j].0 == key {
+                j += 1;
+            }
+            match j - i {
+                1 => {}
+                2 => {
+                    let (a, b) = (facets[i].1 as usize, facets[i + 1].1 as usize);
+                    neighbors[a] = (b / stride) as u32;
+                    neighbors[b] = (a / stride) as u32;
+                }
+                _ => {
+                    let third = facets[i + 2].1;
+                    if non_manifold_at.as_ref().is_none_or(|(t, _)| third < *t) {
+                        let holder = |k: usize| facets[i + k].1 / stride as u32;
+                        let error = non_manifold(key, holder(0), holder(1), holder(2) as usize);
+                        non_manifold_at = Some((third, error));
                     }
                 }
             }
+            i = j;
         }
+        if let Some((_, error)) = non_manifold_at {
+            return Err(error);
+        }
+        drop(facets);
 
         // Boundary facets: outward normal is −∇λ_opposite / |∇λ_opposite|, and the facet
         // measure is D · vol · |∇λ_opposite| (vol = measure · height / D, height = 1/|∇λ|).
@@ -154,31 +207,57 @@ impl<const D: usize> Topology<D> {
             .filter(|&v| on_boundary[v as usize])
             .collect();
 
-        // 1-rings with adjacency bitmasks.
-        let mut ring_rows: Vec<Vec<u32>> = Vec::with_capacity(n_simplices);
-        let mut mask_rows: Vec<Vec<u8>> = Vec::with_capacity(n_simplices);
-        for verts in simplices.chunks_exact(stride) {
-            let mut others: Vec<u32> = verts
-                .iter()
-                .flat_map(|&h| adjacency.row(h as usize).iter().copied())
-                .filter(|v| !verts.contains(v))
-                .collect();
-            others.sort_unstable();
-            others.dedup();
-            let ring: Vec<u32> = verts.iter().copied().chain(others).collect();
-            let masks = ring
-                .iter()
-                .map(|&v| {
-                    verts.iter().enumerate().fold(0u8, |mask, (n, &h)| {
-                        let adjacent_to_h =
-                            v == h || adjacency.row(h as usize).binary_search(&v).is_ok();
-                        mask | (u8::from(adjacent_to_h) << n)
-                    })
+        // 1-rings with adjacency bitmasks, per chunk of simplices in parallel: the
+        // pairs (v, n) for every host vertex n and every v equal or adjacent to it,
+        // sorted, give each ring vertex once with its mask as the OR of its pairs' bits.
+        let (one_ring_vertices, one_ring_masks) = {
+            let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<u8>)> = simplices
+                .par_chunks(ROW_CHUNK * stride)
+                .map(|chunk| {
+                    let (mut lengths, mut ring, mut masks) = (Vec::new(), Vec::new(), Vec::new());
+                    let mut pairs: Vec<(u32, u8)> = Vec::new();
+                    for verts in chunk.chunks_exact(stride) {
+                        pairs.clear();
+                        for (n, &h) in verts.iter().enumerate() {
+                            pairs.push((h, 1 << n));
+                            pairs.extend(adjacency.row(h as usize).iter().map(|&v| (v, 1u8 << n)));
+                        }
+                        pairs.sort_unstable_by_key(|p| p.0);
+                        let start = ring.len();
+                        // The hosts first, in local order.
+                        for &h in verts {
+                            ring.push(h);
+                            masks.push(0);
+                        }
+                        for &(v, bit) in &pairs {
+                            if let Some(n) = verts.iter().position(|&h| h == v) {
+                                masks[start + n] |= bit;
+                            } else if ring.len() > start + stride
+                                && *ring.last().expect("not empty") == v
+                            {
+                                *masks.last_mut().expect("not empty") |= bit;
+                            } else {
+                                ring.push(v);
+                                masks.push(bit);
+                            }
+                        }
+                        lengths.push(ring.len() - start);
+                    }
+                    (lengths, ring, masks)
                 })
                 .collect();
-            ring_rows.push(ring);
-            mask_rows.push(masks);
-        }
+            let total = chunks.iter().map(|c| c.1.len()).sum();
+            let (mut ring, mut masks) = (Vec::with_capacity(total), Vec::with_capacity(total));
+            for (_, r, m) in &chunks {
+                ring.extend_from_slice(r);
+                masks.extend_from_slice(m);
+            }
+            let lengths = || chunks.iter().flat_map(|c| c.0.iter().copied());
+            (
+                Csr::from_lengths(lengths(), ring, "1-ring entries")?,
+                Csr::from_lengths(lengths(), masks, "1-ring entries")?,
+            )
+        };
 
         Ok(Self {
             adjacency,
@@ -187,8 +266,8 @@ impl<const D: usize> Topology<D> {
             boundary_facets,
             boundary_vertices,
             vertex_normals,
-            one_ring_vertices: Csr::from_rows(ring_rows),
-            one_ring_masks: Csr::from_rows(mask_rows),
+            one_ring_vertices,
+            one_ring_masks,
         })
     }
 

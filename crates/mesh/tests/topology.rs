@@ -23,6 +23,19 @@ fn check_adjacency<const D: usize>(mesh: &SimplexMesh<D>) -> Result<(), TestCase
         for &s in topo.vertex_simplices(v) {
             prop_assert!(mesh.simplex(s as usize).contains(&(v as u32)));
         }
+        // Rows ascending, without repeats.
+        prop_assert!(topo.adjacent_vertices(v).windows(2).all(|w| w[0] < w[1]));
+        prop_assert!(topo.vertex_simplices(v).windows(2).all(|w| w[0] < w[1]));
+    }
+    // Complete: every simplex is in its vertices' incidence rows, and its vertices are
+    // pairwise adjacent.
+    for s in 0..mesh.simplex_count() {
+        for &a in mesh.simplex(s) {
+            prop_assert!(topo.vertex_simplices(a as usize).contains(&(s as u32)));
+            for &b in mesh.simplex(s) {
+                prop_assert!(a == b || topo.adjacent_vertices(a as usize).contains(&b));
+            }
+        }
     }
     Ok(())
 }
@@ -107,6 +120,8 @@ fn check_one_rings<const D: usize>(mesh: &SimplexMesh<D>) -> Result<(), TestCase
         }
         expected.sort_unstable();
         expected.dedup();
+        // After the hosts, the others ascending.
+        prop_assert!(ring.vertices[D + 1..].windows(2).all(|w| w[0] < w[1]));
         let mut got = ring.vertices.to_vec();
         got.sort_unstable();
         prop_assert_eq!(got, expected);
