@@ -1,11 +1,12 @@
 //! Project automation, run as `cargo xtask <command>`:
 //!
 //! - `ci`: format check, clippy with `-D warnings`, and the whole test suite in release mode.
-//! - `bench [--quick] [--save-baseline NAME | --baseline NAME] [--docs]`: the comparison
-//!   report in `target/report/` (`umls report`: the study matrix of scenes × kernels ×
-//!   resolutions, charts, raw results), after the criterion benches of every crate
-//!   (skipped by `--quick`, whose matrix has coarse levels only); `--docs` copies the
-//!   report to `docs/report/`.
+//! - `bench [--quick] [--no-criterion] [--save-baseline NAME | --baseline NAME] [--docs]`:
+//!   the comparison report in `target/report/` (`umls report`: the study matrix of
+//!   scenes × kernels × resolutions, charts, raw results), after the criterion benches of
+//!   every crate (skipped by `--quick`, whose matrix has coarse levels only, and by
+//!   `--no-criterion`, which reports the criterion results already there); `--docs`
+//!   copies the report to `docs/report/`.
 //! - `deny`: `cargo deny check` (needs `cargo install cargo-deny`).
 
 use std::path::{Path, PathBuf};
@@ -19,7 +20,7 @@ fn main() -> ExitCode {
         Some("deny") => cargo(&["deny", "check"]),
         _ => {
             eprintln!(
-                "usage: cargo xtask <ci | bench [--quick] [--save-baseline NAME | --baseline NAME] [--docs] | deny>"
+                "usage: cargo xtask <ci | bench [--quick] [--no-criterion] [--save-baseline NAME | --baseline NAME] [--docs] | deny>"
             );
             return ExitCode::from(2);
         }
@@ -85,6 +86,7 @@ fn ci() -> Result<(), String> {
 #[derive(Debug, Default)]
 struct BenchArgs {
     quick: bool,
+    no_criterion: bool,
     save_baseline: Option<String>,
     baseline: Option<String>,
     docs: bool,
@@ -101,6 +103,7 @@ fn bench_args(args: &[String]) -> Result<BenchArgs, String> {
         };
         match arg.as_str() {
             "--quick" => parsed.quick = true,
+            "--no-criterion" => parsed.no_criterion = true,
             "--docs" => parsed.docs = true,
             "--save-baseline" => parsed.save_baseline = Some(value("--save-baseline")?),
             "--baseline" => parsed.baseline = Some(value("--baseline")?),
@@ -113,7 +116,7 @@ fn bench_args(args: &[String]) -> Result<BenchArgs, String> {
 fn bench(args: &[String]) -> Result<(), String> {
     let args = bench_args(args)?;
     let root = workspace_root();
-    if !args.quick {
+    if !args.quick && !args.no_criterion {
         let mut criterion = vec!["bench", "--workspace", "--"];
         if let Some(name) = &args.save_baseline {
             criterion.extend(["--save-baseline", name]);

@@ -38,14 +38,14 @@ pub fn speed_accuracy(study: &AccuracyStudy, records: &[&Record]) -> LineChart {
             let points = runs
                 .iter()
                 .filter(|r| r.completed())
-                .filter_map(|r| Some((r.wall_time_s?, r.metric?)))
+                .filter_map(|r| Some((r.step_time_s?, r.metric?)))
                 .collect();
             Series::new(label, points).with_markers()
         })
         .collect();
     LineChart {
         title: format!("{}: error against run time", study.common.title),
-        x: Axis::log("wall time of the run [s]"),
+        x: Axis::log("time in the steps [s] (output excluded)"),
         y: Axis::log(study.metric_label.clone()),
         series,
     }

@@ -70,11 +70,15 @@ pub struct Record {
     pub dt: Option<f64>,
     /// Largest wave Courant number of the run.
     pub max_wave_courant: Option<f64>,
-    /// Stepping wall time (summary `wall_time_s`).
+    /// Time in the steps themselves: the sum of the stage times (output, history rows
+    /// and setup excluded).
+    pub step_time_s: Option<f64>,
+    /// Wall time of the run's loop (summary `wall_time_s`: steps plus output).
     pub wall_time_s: Option<f64>,
     /// Whole process wall time (setup, stepping, output).
     pub process_time_s: f64,
-    /// Particle-steps per second while stepping.
+    /// Particle-steps per second of the steps themselves (particles × steps /
+    /// `step_time_s`).
     pub particle_steps_per_second: Option<f64>,
     /// Peak resident memory of the run's process.
     pub peak_memory_bytes: Option<u64>,
@@ -176,9 +180,13 @@ impl Record {
             steps: uint("steps"),
             dt: float("dt"),
             max_wave_courant: float("max_wave_courant"),
+            step_time_s: stage("total"),
             wall_time_s: float("wall_time_s"),
             process_time_s: output.process_seconds,
-            particle_steps_per_second: float("particle_steps_per_second"),
+            particle_steps_per_second: match (uint("particles"), uint("steps"), stage("total")) {
+                (Some(n), Some(k), Some(t)) if t > 0.0 => Some((n * k) as f64 / t),
+                _ => None,
+            },
             peak_memory_bytes: uint("peak_memory_bytes"),
             stage_stencils_s: stage("stencils"),
             stage_p2g_s: stage("particles_to_grid"),

@@ -265,12 +265,14 @@ impl Document {
                 .collect::<Vec<_>>()
                 .join(", ")
         ));
-        self.line(
-            "Wall times are the time stepping of each run (setup and output excluded), \
-             measured in a process of its own with the thread count given; peak memory is \
-             that process's resident high-water mark. Raw numbers: `results.csv`, \
-             `results.json`.\n",
-        );
+        self.line(format!(
+            "Times are the time in the steps themselves (the sum of the stage times; setup, \
+                 output frames and history rows excluded), each run in a process of its own on \
+                 {} threads unless a table says otherwise; throughput is particles × steps over \
+                 that time; peak memory is the process's resident high-water mark. Raw numbers: \
+                 `results.csv`, `results.json`.\n",
+            matrix.threads
+        ));
     }
 
     fn accuracy(&mut self, matrix: &Matrix, records: &[Record]) -> Result<()> {
@@ -297,13 +299,13 @@ impl Document {
             // Pareto front over all runs of the study.
             let points: Vec<(f64, f64)> = runs
                 .iter()
-                .map(|r| match (r.completed(), r.wall_time_s, r.metric) {
+                .map(|r| match (r.completed(), r.step_time_s, r.metric) {
                     (true, Some(t), Some(e)) => (t, e),
                     _ => (f64::NAN, f64::NAN),
                 })
                 .collect();
             let front = pareto_front(&points);
-            self.line("| kernel | h | particles | status | error | wall time [s] | M particle-steps/s | peak memory [MB] | Pareto |");
+            self.line("| kernel | h | particles | status | error | time in the steps [s] | M particle-steps/s | peak memory [MB] | Pareto |");
             self.line("|---|---|---|---|---|---|---|---|---|");
             for (i, r) in runs.iter().enumerate() {
                 self.line(format!(
@@ -313,7 +315,7 @@ impl Document {
                     r.particles.map_or("—".into(), |n| n.to_string()),
                     status_text(r),
                     num(r.metric),
-                    num(r.wall_time_s),
+                    num(r.step_time_s),
                     num(r.particle_steps_per_second.map(|x| x / 1e6)),
                     num(r.peak_memory_bytes.map(|b| b as f64 / 1e6)),
                     if front.contains(&i) { "●" } else { "" },
