@@ -91,7 +91,7 @@ pub fn stability_map(study: &StabilityStudy, records: &[&Record]) -> StatusMap {
                                 .map(|e| format!("gain {:.0}%", 100.0 * e))
                                 .unwrap_or_default(),
                         ),
-                        _ => (Outcome::Failed, r.failure_kind.clone()),
+                        _ => (Outcome::Failed, short_kind(&r.failure_kind).to_string()),
                     };
                     Some(MapCell {
                         x,
@@ -190,5 +190,16 @@ pub fn scaling(study: &ThroughputStudy, records: &[&Record]) -> LineChart {
                 Series::new(label, points).with_markers()
             })
             .collect(),
+    }
+}
+
+/// A failure kind short enough for a map cell (the tables give the full kind and message).
+fn short_kind(kind: &str) -> &str {
+    match kind {
+        "time-step-too-large" => "Δt > stable",
+        "energy-blow-up" => "blow-up",
+        "non-finite" => "NaN",
+        "no-summary" => "no run",
+        other => other,
     }
 }
