@@ -8,7 +8,7 @@ use umls_constitutive::{
     ConeFit, DruckerPrager, ElasticParameters, ElastoPlastic, FixedCorotated, LinearElastic,
     NeoHookean, StVenantKirchhoff, VonMises, WeaklyCompressibleFluid,
 };
-use umls_engine::{Damping, Region, StressUpdate, lattice_samples};
+use umls_engine::{Damping, Region, StressUpdate, lattice_points};
 use umls_io::gmsh::{PhysicalGroup, ReadOptions, parse_msh};
 use umls_mesh::generate::{Diagonal, Lattice};
 use umls_mesh::{Orientation, SampleRule, SimplexMesh};
@@ -457,9 +457,9 @@ fn seed_body<const D: usize>(
                 ));
             }
             let corner = origin + first * *h;
-            lattice_samples(corner, origin + last * *h, *h)
-                .into_iter()
-                .filter(|(x, _)| background.contains(x))
+            // Only the body's points are kept: the box's whole lattice never exists.
+            lattice_points(corner, origin + last * *h, *h)
+                .filter(|(x, _)| region.contains(x) && background.contains(x))
                 .collect()
         }
         SeedingSpec::Lattice(h) => {
@@ -484,9 +484,8 @@ fn seed_body<const D: usize>(
             }
             // Lattice points over the bounding box; those outside the mesh itself (a
             // non-convex Gmsh domain) would stop the run at its first step.
-            lattice_samples(lower, upper, *h)
-                .into_iter()
-                .filter(|(x, _)| background.contains(x))
+            lattice_points(lower, upper, *h)
+                .filter(|(x, _)| region.contains(x) && background.contains(x))
                 .collect()
         }
         SeedingSpec::Mesh(rule) => {

@@ -62,7 +62,7 @@ pub use boundary::{Boundary, Reaction, Wall, WallKind};
 pub use diagnostics::Diagnostics;
 pub use error::EngineError;
 pub use particles::Particles;
-pub use seeding::{Inside, Region, lattice_samples};
+pub use seeding::{Inside, Region, lattice_points, lattice_samples};
 pub use settings::{Damping, StepSettings, TimeStepControl};
 pub use simulation::{BodyForce, Simulation};
 pub use timing::StageTimes;

@@ -99,19 +99,28 @@ pub fn lattice_samples<const D: usize>(
     upper: SVector<f64, D>,
     h: f64,
 ) -> Vec<(SVector<f64, D>, f64)> {
+    lattice_points(lower, upper, h).collect()
+}
+
+/// [`lattice_samples`] one at a time, so a caller that keeps only the points inside a
+/// body never holds the whole box's lattice (a million points for a 0.01 lattice in the
+/// unit cube).
+pub fn lattice_points<const D: usize>(
+    lower: SVector<f64, D>,
+    upper: SVector<f64, D>,
+    h: f64,
+) -> impl Iterator<Item = (SVector<f64, D>, f64)> {
     let counts: [usize; D] =
         std::array::from_fn(|k| ((upper[k] - lower[k]) / h).round().max(0.0) as usize);
     let total: usize = counts.iter().product();
-    (0..total)
-        .map(|mut index| {
-            let x = SVector::<f64, D>::from_fn(|k, _| {
-                let i = index % counts[k];
-                index /= counts[k];
-                lower[k] + (i as f64 + 0.5) * h
-            });
-            (x, h.powi(D as i32))
-        })
-        .collect()
+    (0..total).map(move |mut index| {
+        let x = SVector::<f64, D>::from_fn(|k, _| {
+            let i = index % counts[k];
+            index /= counts[k];
+            lower[k] + (i as f64 + 0.5) * h
+        });
+        (x, h.powi(D as i32))
+    })
 }
 
 impl<const D: usize, S: Clone, C: Copy + Default> Particles<D, S, C> {
