@@ -86,13 +86,13 @@ impl<const D: usize> Topology<D> {
         // Each vertex's neighbours: the other vertices of its simplices, per vertex in
         // parallel chunks.
         let adjacency = {
-            let chunks: Vec<(Vec<usize>, Vec<u32>)> = (0..vertex_count)
-                .collect::<Vec<_>>()
-                .par_chunks(ROW_CHUNK)
-                .map(|chunk| {
+            let chunks: Vec<(Vec<usize>, Vec<u32>)> = (0..vertex_count.div_ceil(ROW_CHUNK))
+                .into_par_iter()
+                .map(|c| {
+                    let chunk = c * ROW_CHUNK..((c + 1) * ROW_CHUNK).min(vertex_count);
                     let (mut lengths, mut values) = (Vec::with_capacity(chunk.len()), Vec::new());
                     let mut row = Vec::new();
-                    for &v in chunk {
+                    for v in chunk {
                         row.clear();
                         for &s in vertex_simplices.row(v) {
                             let verts = &simplices[s as usize * stride..][..stride];
@@ -106,14 +106,9 @@ impl<const D: usize> Topology<D> {
                     (lengths, values)
                 })
                 .collect();
-            let total = chunks.iter().map(|c| c.1.len()).sum();
-            let mut values = Vec::with_capacity(total);
-            for (_, v) in &chunks {
-                values.extend_from_slice(v);
-            }
-            Csr::from_lengths(
-                chunks.iter().flat_map(|c| c.0.iter().copied()),
-                values,
+            joined(
+                chunks.iter().map(|c| &c.0[..]),
+                chunks.iter().map(|c| &c.1[..]),
                 "vertex adjacencies",
             )?
         };
@@ -246,16 +241,10 @@ impl<const D: usize> Topology<D> {
                     (lengths, ring, masks)
                 })
                 .collect();
-            let total = chunks.iter().map(|c| c.1.len()).sum();
-            let (mut ring, mut masks) = (Vec::with_capacity(total), Vec::with_capacity(total));
-            for (_, r, m) in &chunks {
-                ring.extend_from_slice(r);
-                masks.extend_from_slice(m);
-            }
-            let lengths = || chunks.iter().flat_map(|c| c.0.iter().copied());
+            let lengths = || chunks.iter().map(|c| &c.0[..]);
             (
-                Csr::from_lengths(lengths(), ring, "1-ring entries")?,
-                Csr::from_lengths(lengths(), masks, "1-ring entries")?,
+                joined(lengths(), chunks.iter().map(|c| &c.1[..]), "1-ring entries")?,
+                joined(lengths(), chunks.iter().map(|c| &c.2[..]), "1-ring entries")?,
             )
         };
 
@@ -341,6 +330,20 @@ pub(crate) fn barycentric_gradient<const D: usize>(
     } else {
         inverse.row(local - 1).transpose()
     }
+}
+
+/// The rows that parallel chunks built (each chunk's row lengths and values back to
+/// back), joined in chunk order into one CSR.
+fn joined<'a, T: Copy + 'a>(
+    lengths: impl Iterator<Item = &'a [usize]>,
+    values: impl Iterator<Item = &'a [T]>,
+    what: &'static str,
+) -> Result<Csr<T>, MeshError> {
+    Csr::from_lengths(
+        lengths.flatten().copied(),
+        values.flatten().copied().collect(),
+        what,
+    )
 }
 
 fn non_manifold(key: [u32; 3], first: u32, second: u32, third: usize) -> MeshError {
