@@ -62,7 +62,30 @@ def slope_box():
     gmsh.model.mesh.generate(3)
 
 
+def column():
+    """The room [0, 1] x [0, 4.4] of the hydrostatic column, unstructured triangles of
+    size 0.1 (the lattice scene's cell); the walls are planes of the scene file."""
+    r = gmsh.model.occ.addRectangle(0, 0, 0, 1.0, 4.4)
+    gmsh.model.occ.synchronize()
+    gmsh.model.mesh.setSize(gmsh.model.getEntities(0), 0.1)
+    gmsh.model.addPhysicalGroup(2, [r], name="room")
+    gmsh.model.mesh.generate(2)
+
+
+def column_3d():
+    """The box [0, 1] x [0, 1] x [0, 4.4] of the 3D hydrostatic column, tetrahedra of
+    size 0.2 (the lattice scene's cell)."""
+    box = gmsh.model.occ.addBox(0, 0, 0, 1.0, 1.0, 4.4)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.2)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.2)
+    gmsh.model.addPhysicalGroup(3, [box], name="box")
+    gmsh.model.mesh.generate(3)
+
+
 mesh("cantilever", cantilever)
 mesh("cantilever-room", cantilever_room)
 mesh("sphere-container", sphere_container, binary=True)
 mesh("slope-box", slope_box, binary=True)
+mesh("column", column)
+mesh("column-3d", column_3d, binary=True)

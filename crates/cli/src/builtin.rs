@@ -13,7 +13,7 @@ pub struct Builtin {
 }
 
 /// Every built-in scene.
-pub const BUILTIN: [Builtin; 12] = [
+pub const BUILTIN: [Builtin; 14] = [
     Builtin {
         name: "colliding-disks",
         summary: "two elastic disks collide and rebound (Sulsky et al. 1994) on a jittered triangle mesh",
@@ -38,6 +38,16 @@ pub const BUILTIN: [Builtin; 12] = [
         name: "hydrostatic-column-tilted",
         summary: "the hydrostatic column turned by 30°: the mesh conforms to the inclined walls, a B-spline grid cannot",
         toml: include_str!("../../../scenes/hydrostatic-column-tilted.toml"),
+    },
+    Builtin {
+        name: "hydrostatic-column-gmsh",
+        summary: "the hydrostatic column on unstructured Gmsh triangles",
+        toml: include_str!("../../../scenes/hydrostatic-column-gmsh.toml"),
+    },
+    Builtin {
+        name: "hydrostatic-column-3d-gmsh",
+        summary: "the 3D hydrostatic column on unstructured Gmsh tetrahedra",
+        toml: include_str!("../../../scenes/hydrostatic-column-3d-gmsh.toml"),
     },
     Builtin {
         name: "hydrostatic-column-3d",
@@ -78,7 +88,7 @@ pub const BUILTIN: [Builtin; 12] = [
 
 /// Files the built-in scenes refer to (meshes, reference data), by the name the scene
 /// uses.
-pub const FILES: [(&str, &[u8]); 5] = [
+pub const FILES: [(&str, &[u8]); 7] = [
     (
         "meshes/cantilever.msh",
         include_bytes!("../../../scenes/meshes/cantilever.msh"),
@@ -94,6 +104,14 @@ pub const FILES: [(&str, &[u8]); 5] = [
     (
         "meshes/slope-box.msh",
         include_bytes!("../../../scenes/meshes/slope-box.msh"),
+    ),
+    (
+        "meshes/column.msh",
+        include_bytes!("../../../scenes/meshes/column.msh"),
+    ),
+    (
+        "meshes/column-3d.msh",
+        include_bytes!("../../../scenes/meshes/column-3d.msh"),
     ),
     (
         "data/cantilever-tip.csv",

@@ -8,7 +8,7 @@ use umls_engine::{Wall, WallKind};
 
 use crate::error::Result;
 use crate::run::{Context, Run};
-use crate::schema::{BoundaryKind, KernelKind};
+use crate::schema::BoundaryKind;
 use crate::setup::BoundaryTarget;
 
 /// Walls on planes, and fixed or slip conditions on the nodes of mesh groups.
@@ -17,7 +17,7 @@ pub(crate) fn apply_boundaries<const D: usize>(
     sim: &mut dyn Run<D>,
 ) -> Result<()> {
     let scene = ctx.scene;
-    let mesh_kernel = matches!(ctx.kernel, KernelKind::Umls | KernelKind::LinearFe);
+    let mesh_kernel = ctx.kernel.on_mesh();
     for (i, (kind, target)) in ctx.setup.boundaries.iter().enumerate() {
         let wall_kind = match kind {
             BoundaryKind::Fixed => WallKind::Fixed,

@@ -18,8 +18,9 @@ use umls_engine::{
 };
 use umls_io::csv::HistoryWriter;
 use umls_io::vtk::Encoding;
-use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, Umls1, Umls2, Umls3};
+use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, UmlsMeshKernel};
 use umls_mesh::SimplexMesh;
+use umls_mls::{DEFAULT_SUPPORT_FACTOR, Linear, Profile, Quadratic, SupportRadius, UmlsKernel};
 use umls_transfer::Kernel;
 
 use crate::error::{CliError, Result};
@@ -30,7 +31,7 @@ use crate::probes::Probes;
 use crate::progress::Progress;
 use crate::reference;
 use crate::scene::Scene;
-use crate::schema::{EncodingSpec, KernelKind, TransferKind};
+use crate::schema::{EncodingSpec, KernelKind, SupportSpec, TransferKind, WeightSpec};
 use crate::setup::{self, Setup, Split};
 use crate::{conditions, end_metrics};
 use umls_constitutive::Constitutive;
@@ -69,8 +70,13 @@ pub struct RunReport {
 /// whether plastic models exist.
 trait Dimension<const D: usize> {
     type Umls: Kernel<D>;
+    type UmlsQuadratic: Kernel<D>;
     const SPLIT: Split<D>;
-    fn umls(mesh: Arc<SimplexMesh<D>>) -> Self::Umls;
+    fn umls(mesh: Arc<SimplexMesh<D>>, mls: UmlsKernel<D, Profile>) -> Self::Umls;
+    fn umls_quadratic(
+        mesh: Arc<SimplexMesh<D>>,
+        mls: UmlsKernel<D, Profile>,
+    ) -> Self::UmlsQuadratic;
     fn run_plastic<K: Kernel<D>>(ctx: &Context<'_, D>, kernel: K) -> Result<RunReport>;
 }
 
@@ -79,10 +85,17 @@ struct D2;
 struct D3;
 
 impl Dimension<1> for D1 {
-    type Umls = Umls1;
+    type Umls = UmlsMeshKernel<1, 2, Linear, Profile>;
+    type UmlsQuadratic = UmlsMeshKernel<1, 3, Quadratic, Profile>;
     const SPLIT: Split<1> = setup::segments;
-    fn umls(mesh: Arc<SimplexMesh<1>>) -> Umls1 {
-        Umls1::new(mesh)
+    fn umls(mesh: Arc<SimplexMesh<1>>, mls: UmlsKernel<1, Profile>) -> Self::Umls {
+        UmlsMeshKernel::with_kernel(mesh, mls)
+    }
+    fn umls_quadratic(
+        mesh: Arc<SimplexMesh<1>>,
+        mls: UmlsKernel<1, Profile>,
+    ) -> Self::UmlsQuadratic {
+        UmlsMeshKernel::with_kernel(mesh, mls)
     }
     fn run_plastic<K: Kernel<1>>(ctx: &Context<'_, 1>, _: K) -> Result<RunReport> {
         Err(setup::plastic_in_1d(ctx.scene))
@@ -90,10 +103,17 @@ impl Dimension<1> for D1 {
 }
 
 impl Dimension<2> for D2 {
-    type Umls = Umls2;
+    type Umls = UmlsMeshKernel<2, 3, Linear, Profile>;
+    type UmlsQuadratic = UmlsMeshKernel<2, 6, Quadratic, Profile>;
     const SPLIT: Split<2> = setup::triangles;
-    fn umls(mesh: Arc<SimplexMesh<2>>) -> Umls2 {
-        Umls2::new(mesh)
+    fn umls(mesh: Arc<SimplexMesh<2>>, mls: UmlsKernel<2, Profile>) -> Self::Umls {
+        UmlsMeshKernel::with_kernel(mesh, mls)
+    }
+    fn umls_quadratic(
+        mesh: Arc<SimplexMesh<2>>,
+        mls: UmlsKernel<2, Profile>,
+    ) -> Self::UmlsQuadratic {
+        UmlsMeshKernel::with_kernel(mesh, mls)
     }
     fn run_plastic<K: Kernel<2>>(ctx: &Context<'_, 2>, kernel: K) -> Result<RunReport> {
         with_material(
@@ -107,10 +127,17 @@ impl Dimension<2> for D2 {
 }
 
 impl Dimension<3> for D3 {
-    type Umls = Umls3;
+    type Umls = UmlsMeshKernel<3, 4, Linear, Profile>;
+    type UmlsQuadratic = UmlsMeshKernel<3, 10, Quadratic, Profile>;
     const SPLIT: Split<3> = setup::tetrahedra;
-    fn umls(mesh: Arc<SimplexMesh<3>>) -> Umls3 {
-        Umls3::new(mesh)
+    fn umls(mesh: Arc<SimplexMesh<3>>, mls: UmlsKernel<3, Profile>) -> Self::Umls {
+        UmlsMeshKernel::with_kernel(mesh, mls)
+    }
+    fn umls_quadratic(
+        mesh: Arc<SimplexMesh<3>>,
+        mls: UmlsKernel<3, Profile>,
+    ) -> Self::UmlsQuadratic {
+        UmlsMeshKernel::with_kernel(mesh, mls)
     }
     fn run_plastic<K: Kernel<3>>(ctx: &Context<'_, 3>, kernel: K) -> Result<RunReport> {
         with_material(
@@ -196,12 +223,75 @@ fn run_dim<const D: usize, X: Dimension<D>>(
         })
     };
     match ctx.kernel {
-        KernelKind::Umls => with_kernel::<D, X, _>(&ctx, X::umls(mesh()?)),
+        KernelKind::Umls
+        | KernelKind::UmlsWendland
+        | KernelKind::UmlsWide
+        | KernelKind::UmlsPaper => {
+            let mesh = mesh()?;
+            let mls = umls_settings(&ctx, &mesh)?;
+            with_kernel::<D, X, _>(&ctx, X::umls(mesh, mls))
+        }
+        KernelKind::UmlsQuadratic => {
+            let mesh = mesh()?;
+            let mls = umls_settings(&ctx, &mesh)?;
+            with_kernel::<D, X, _>(&ctx, X::umls_quadratic(mesh, mls))
+        }
         KernelKind::LinearFe => with_kernel::<D, X, _>(&ctx, LinearFeKernel::new(mesh()?)),
         KernelKind::Bspline2 => {
             with_kernel::<D, X, _>(&ctx, bspline(&ctx, BSplineOrder::Quadratic)?)
         }
         KernelKind::Bspline3 => with_kernel::<D, X, _>(&ctx, bspline(&ctx, BSplineOrder::Cubic)?),
+    }
+}
+
+/// The MLS settings of a UMLS kernel: the kernel name's preset (profile, radius rule
+/// and factor), with `[kernel]`'s `weight`, `support` and `support_factor` overriding
+/// it. The quadratic basis needs six (2D) or ten (3D) weighted samples, more than a
+/// vertex on a wall or in a corner has, so its quadratic terms carry a small ridge.
+fn umls_settings<const D: usize>(
+    ctx: &Context<'_, D>,
+    mesh: &SimplexMesh<D>,
+) -> Result<UmlsKernel<D, Profile>> {
+    let spec = &ctx.scene.spec.kernel;
+    let (weight, support, factor) = umls_preset(ctx.kernel);
+    let weight = match spec.weight.unwrap_or(weight) {
+        WeightSpec::CubicBspline => Profile::CubicBSpline,
+        WeightSpec::Wendland => Profile::WendlandC2,
+    };
+    let factor = spec.support_factor.unwrap_or(factor);
+    let support = match spec.support.unwrap_or(support) {
+        SupportSpec::PerVertex => SupportRadius::PerVertex { factor },
+        SupportSpec::IncidentEdge => SupportRadius::IncidentEdge { factor },
+        SupportSpec::Global => SupportRadius::Global { factor },
+    };
+    let mut mls = UmlsKernel::with_weight(mesh, weight, support).map_err(|e| {
+        ctx.scene
+            .value_error("kernel.support_factor", e.to_string())
+    })?;
+    if ctx.kernel == KernelKind::UmlsQuadratic {
+        mls.conditioning.higher_order_ridge = QUADRATIC_RIDGE;
+    }
+    Ok(mls)
+}
+
+/// Relative ridge on the quadratic monomials of `umls-quadratic`.
+const QUADRATIC_RIDGE: f64 = 1e-3;
+
+/// Profile, radius rule and factor of each UMLS kernel name.
+fn umls_preset(kind: KernelKind) -> (WeightSpec, SupportSpec, f64) {
+    match kind {
+        KernelKind::UmlsWide => (WeightSpec::CubicBspline, SupportSpec::PerVertex, 1.0),
+        KernelKind::UmlsPaper => (WeightSpec::CubicBspline, SupportSpec::Global, 1.0),
+        KernelKind::UmlsWendland => (
+            WeightSpec::Wendland,
+            SupportSpec::IncidentEdge,
+            DEFAULT_SUPPORT_FACTOR,
+        ),
+        _ => (
+            WeightSpec::CubicBspline,
+            SupportSpec::IncidentEdge,
+            DEFAULT_SUPPORT_FACTOR,
+        ),
     }
 }
 
@@ -511,7 +601,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     let mut warnings = setup.warnings.clone();
     let stable_dt = sim.stable_time_step(1.0);
     let (steps, dt_cap) = plan_time_step(ctx, sim, stable_dt, &mut warnings)?;
-    let mesh_kernel = matches!(ctx.kernel, KernelKind::Umls | KernelKind::LinearFe);
+    let mesh_kernel = ctx.kernel.on_mesh();
     conditions::apply_boundaries(ctx, sim)?;
     for w in &warnings {
         eprintln!("warning: {w}");

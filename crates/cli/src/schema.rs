@@ -159,9 +159,19 @@ pub struct LatticeSpec {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum KernelKind {
-    /// C¹ UMLS kernel on the mesh (linear basis).
+    /// C¹ UMLS kernel on the mesh: linear basis, cubic B-spline weights with the
+    /// incident-edge support radius (docs/umls-kernel.md has the study that chose it).
     #[default]
     Umls,
+    /// UMLS with the quadratic basis on the 1-ring (ridge on the quadratic terms).
+    UmlsQuadratic,
+    /// UMLS with Wendland C² distance weights.
+    UmlsWendland,
+    /// UMLS with the wide per-vertex support (each vertex's farthest stencil reach), the
+    /// default before the support study.
+    UmlsWide,
+    /// UMLS with the paper's one global radius, the mesh's longest edge.
+    UmlsPaper,
     /// Linear finite-element shape functions on the mesh.
     LinearFe,
     /// Quadratic B-splines on a Cartesian grid covering the mesh.
@@ -175,6 +185,10 @@ impl KernelKind {
     pub fn name(self) -> &'static str {
         match self {
             KernelKind::Umls => "umls",
+            KernelKind::UmlsQuadratic => "umls-quadratic",
+            KernelKind::UmlsWendland => "umls-wendland",
+            KernelKind::UmlsWide => "umls-wide",
+            KernelKind::UmlsPaper => "umls-paper",
             KernelKind::LinearFe => "linear-fe",
             KernelKind::Bspline2 => "bspline2",
             KernelKind::Bspline3 => "bspline3",
@@ -192,6 +206,53 @@ pub struct KernelSpec {
     /// Cell size of the B-spline grid (default: the lattice cell size, or the mesh's
     /// longest edge / √D for a file mesh).
     pub grid_spacing: Option<f64>,
+    /// UMLS kernels: the distance-weight profile (default: the kernel name's).
+    pub weight: Option<WeightSpec>,
+    /// UMLS kernels: how the support radius h_v is chosen (default: the kernel name's).
+    pub support: Option<SupportSpec>,
+    /// UMLS kernels: multiplier of the support radius (default: the kernel name's).
+    pub support_factor: Option<f64>,
+}
+
+impl KernelKind {
+    /// Whether the kernel's nodes are the mesh vertices (UMLS or linear FE).
+    pub fn on_mesh(self) -> bool {
+        self.is_umls() || self == KernelKind::LinearFe
+    }
+
+    /// Whether the kernel is one of the UMLS variants.
+    pub fn is_umls(self) -> bool {
+        matches!(
+            self,
+            KernelKind::Umls
+                | KernelKind::UmlsQuadratic
+                | KernelKind::UmlsWendland
+                | KernelKind::UmlsWide
+                | KernelKind::UmlsPaper
+        )
+    }
+}
+
+/// `kernel.weight`: the UMLS distance-weight profile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WeightSpec {
+    /// The cubic B-spline (the paper's).
+    CubicBspline,
+    /// Wendland's C² function.
+    Wendland,
+}
+
+/// `kernel.support`: the UMLS support radius rule.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SupportSpec {
+    /// Per vertex: the farthest reach of the vertex's stencils.
+    PerVertex,
+    /// Per vertex: the longest edge incident to the vertex.
+    IncidentEdge,
+    /// One radius, the mesh's longest edge (the paper's).
+    Global,
 }
 
 /// Transfer names.

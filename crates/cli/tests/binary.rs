@@ -207,7 +207,14 @@ fn vibrating_bar_writes_readable_files() {
 
 #[test]
 fn kernel_override_and_conservation() {
-    for kernel in ["linear-fe", "bspline2", "bspline3"] {
+    for kernel in [
+        "linear-fe",
+        "bspline2",
+        "bspline3",
+        "umls-wide",
+        "umls-paper",
+        "umls-wendland",
+    ] {
         let dir = scratch(&format!("disks-{kernel}"));
         let out = umls(&[
             "run",

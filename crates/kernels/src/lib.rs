@@ -41,4 +41,6 @@ pub mod testing;
 
 pub use bspline::{BSplineKernel, BSplineOrder};
 #[cfg(feature = "mesh")]
-pub use mesh_kernels::{HostCache, LinearFeKernel, Umls1, Umls2, Umls3, UmlsMeshKernel};
+pub use mesh_kernels::{
+    HostCache, LinearFeKernel, Umls1, Umls2, Umls3, UmlsMeshKernel, UmlsQuadratic2, UmlsQuadratic3,
+};

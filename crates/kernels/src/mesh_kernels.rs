@@ -3,8 +3,10 @@
 use std::sync::Arc;
 
 use nalgebra::SVector;
+use std::marker::PhantomData;
 use umls_mesh::{Barycentric, SimplexMesh};
-use umls_mls::{GradientKind, Linear, PolynomialBasis, UmlsKernel};
+
+use umls_mls::{CubicBSpline, GradientKind, Linear, PolynomialBasis, UmlsKernel, WeightFunction};
 use umls_transfer::{DomainExit, Kernel, KernelError, Stencil};
 
 /// The node methods of a kernel whose nodes are the vertices of `self.mesh`.
@@ -108,14 +110,21 @@ fn locate<const D: usize>(
     Ok(found.simplex)
 }
 
-/// The UMLS kernel (C¹ diminishing-weight MLS over the host's 1-ring, linear basis,
-/// reconstructed gradient) as an MPM kernel. Nodes are the mesh vertices.
+/// The UMLS kernel (C¹ diminishing-weight MLS over the host's 1-ring, reconstructed
+/// gradient) as an MPM kernel. Nodes are the mesh vertices.
 ///
-/// `N` is the linear basis size D + 1; use the aliases [`Umls1`], [`Umls2`], [`Umls3`].
+/// `N` is the size of the polynomial basis `B` (D + 1 for [`Linear`], the default;
+/// (D + 1)(D + 2)/2 for [`umls_mls::Quadratic`]) and `W` the distance-weight profile.
+/// Use the aliases [`Umls1`], [`Umls2`], [`Umls3`] for the paper's kernel and
+/// [`UmlsQuadratic2`], [`UmlsQuadratic3`] for the quadratic fit.
 #[derive(Debug, Clone)]
-pub struct UmlsMeshKernel<const D: usize, const N: usize> {
+pub struct UmlsMeshKernel<const D: usize, const N: usize, B = Linear, W = CubicBSpline>
+where
+    W: WeightFunction,
+{
     mesh: Arc<SimplexMesh<D>>,
-    kernel: UmlsKernel<D>,
+    kernel: UmlsKernel<D, W>,
+    basis: PhantomData<fn() -> B>,
 }
 
 /// UMLS on segments.
@@ -124,28 +133,44 @@ pub type Umls1 = UmlsMeshKernel<1, 2>;
 pub type Umls2 = UmlsMeshKernel<2, 3>;
 /// UMLS on tetrahedra.
 pub type Umls3 = UmlsMeshKernel<3, 4>;
+/// UMLS with the quadratic basis on triangles (6 monomials).
+pub type UmlsQuadratic2 = UmlsMeshKernel<2, 6, umls_mls::Quadratic>;
+/// UMLS with the quadratic basis on tetrahedra (10 monomials).
+pub type UmlsQuadratic3 = UmlsMeshKernel<3, 10, umls_mls::Quadratic>;
 
-impl<const D: usize, const N: usize> UmlsMeshKernel<D, N> {
+impl<const D: usize, const N: usize, B> UmlsMeshKernel<D, N, B, CubicBSpline> {
     /// The paper's kernel (cubic B-spline distance weights, per-vertex radii) on `mesh`.
     pub fn new(mesh: Arc<SimplexMesh<D>>) -> Self {
         let kernel = UmlsKernel::new(&mesh);
-        Self { mesh, kernel }
+        Self::with_kernel(mesh, kernel)
     }
+}
 
+impl<const D: usize, const N: usize, B, W: WeightFunction> UmlsMeshKernel<D, N, B, W> {
     /// A kernel with custom MLS settings (weights, radii, conditioning) built for `mesh`.
-    pub fn with_kernel(mesh: Arc<SimplexMesh<D>>, kernel: UmlsKernel<D>) -> Self {
-        Self { mesh, kernel }
+    pub fn with_kernel(mesh: Arc<SimplexMesh<D>>, kernel: UmlsKernel<D, W>) -> Self {
+        Self {
+            mesh,
+            kernel,
+            basis: PhantomData,
+        }
     }
 
     /// The mesh.
     pub fn mesh(&self) -> &Arc<SimplexMesh<D>> {
         &self.mesh
     }
+
+    /// The MLS settings.
+    pub fn kernel(&self) -> &UmlsKernel<D, W> {
+        &self.kernel
+    }
 }
 
-impl<const D: usize, const N: usize> Kernel<D> for UmlsMeshKernel<D, N>
+impl<const D: usize, const N: usize, B, W> Kernel<D> for UmlsMeshKernel<D, N, B, W>
 where
-    Linear: PolynomialBasis<D, N>,
+    B: PolynomialBasis<D, N>,
+    W: WeightFunction,
 {
     type Cache = HostCache;
 
@@ -159,7 +184,7 @@ where
     ) -> Result<(), KernelError> {
         let host = locate(&self.mesh, x, cache)?;
         self.kernel
-            .evaluate::<N, Linear>(&self.mesh, host, x, GradientKind::Reconstructed, out)?;
+            .evaluate::<N, B>(&self.mesh, host, x, GradientKind::Reconstructed, out)?;
         Ok(())
     }
 }

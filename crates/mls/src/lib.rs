@@ -53,5 +53,5 @@ pub use point_cloud::PointCloudMls;
 pub use solve::{Conditioning, IllConditionedPolicy, Samples, shape_functions};
 pub use stencil::{GradientKind, MAX_STENCIL, Stencil};
 #[cfg(feature = "mesh")]
-pub use umls::{HOST_TOLERANCE, SupportRadius, UmlsKernel};
-pub use weight::{CubicBSpline, WeightFunction, WendlandC2};
+pub use umls::{DEFAULT_SUPPORT_FACTOR, HOST_TOLERANCE, SupportRadius, UmlsKernel};
+pub use weight::{CubicBSpline, Profile, WeightFunction, WendlandC2};

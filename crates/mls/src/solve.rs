@@ -39,6 +39,14 @@ pub struct Conditioning {
     pub max_condition: f64,
     /// What to do beyond it.
     pub policy: IllConditionedPolicy,
+    /// Ridge on the monomials of degree two and more, relative to Σw·ℓ⁴ with ℓ the
+    /// weighted spread of the samples, added on every evaluation (default 0; values ≤ 0
+    /// disable it). It keeps a quadratic fit solvable where fewer
+    /// samples than monomials carry weight (a vertex on a wall, a corner) while linear
+    /// fields stay reproduced exactly (their fit has no higher-order coefficients to
+    /// penalise), and, being always on and continuous in x, it keeps the shape functions
+    /// continuous, which a switch at `max_condition` would not.
+    pub higher_order_ridge: f64,
 }
 
 impl Default for Conditioning {
@@ -47,6 +55,7 @@ impl Default for Conditioning {
         Self {
             max_condition: 1e8,
             policy: IllConditionedPolicy::Fail,
+            higher_order_ridge: 0.0,
         }
     }
 }
@@ -119,6 +128,17 @@ pub fn shape_functions<const D: usize, const N: usize, B: PolynomialBasis<D, N>>
             let p = basis(v);
             moment.ger(w, &p, &p, 1.0);
             positive += 1;
+        }
+    }
+    if conditioning.higher_order_ridge > 0.0 && moment[(0, 0)] > 0.0 {
+        // The ridge must not depend on the scale s (it differs between neighbouring
+        // hosts): with ℓ² = Σw|ξ|² / Σw, the weighted spread of the samples, the shift
+        // Σw · ℓ⁴ scales like the quadratic monomials' entries (s⁻⁴), so the regularised
+        // fit is the same for every s and stays continuous across facets.
+        let spread: f64 = (1..=D).map(|i| moment[(i, i)]).sum();
+        let shift = conditioning.higher_order_ridge * spread * spread / moment[(0, 0)];
+        for i in D + 1..N {
+            moment[(i, i)] += shift;
         }
     }
     let (inverse, condition) = invert(moment, positive, conditioning)?;

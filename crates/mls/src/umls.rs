@@ -20,9 +20,22 @@ pub enum SupportRadius {
     /// contains v). With factor ≥ 1, r = |x − x_v| / h_v ≤ 1 for every point where v is in
     /// the stencil, so d_v ≥ W(1) > 0 everywhere it is used (the theory's positivity
     /// requirement) and the radius adapts to graded meshes. h_v belongs to the vertex,
-    /// not to the host, so d_v stays smooth across facets. The default, factor 1.
+    /// not to the host, so d_v stays smooth across facets. Wide: every ring vertex
+    /// weighs at least W(1)/W(0) = 1/4 of the nearest, which smooths transfers and
+    /// boundary stress (the `umls-wide` kernel of the CLI).
     PerVertex {
         /// Multiplier, ≥ 1 keeps d_v > 0 on the whole stencil.
+        factor: f64,
+    },
+    /// h_v = factor · (longest edge incident to v): the vertex's own mesh size. Every
+    /// host vertex v has η_v = 1 (it is adjacent to the whole host), and with factor > 1/2
+    /// its distance weight is positive on every simplex containing it (the profile's
+    /// support 2h_v exceeds the longest edge from v), so the D + 1 host vertices alone
+    /// keep the moment matrix regular; farther 1-ring vertices fade out with distance
+    /// instead of all getting d_v ≥ W(1). Narrower than [`SupportRadius::PerVertex`]:
+    /// less smoothing of PIC/APIC transfers and boundary stress (docs/umls-kernel.md).
+    IncidentEdge {
+        /// Multiplier, > 1/2 keeps every host vertex weighted.
         factor: f64,
     },
     /// One h = factor · (longest edge in the mesh) for all vertices, as in the paper
@@ -34,9 +47,15 @@ pub enum SupportRadius {
     },
 }
 
+/// The factor of the default support radius, [`SupportRadius::IncidentEdge`]: chosen by
+/// the study in docs/umls-kernel.md (accurate walls without linear FE's cell crossing).
+pub const DEFAULT_SUPPORT_FACTOR: f64 = 0.9;
+
 impl Default for SupportRadius {
     fn default() -> Self {
-        Self::PerVertex { factor: 1.0 }
+        Self::IncidentEdge {
+            factor: DEFAULT_SUPPORT_FACTOR,
+        }
     }
 }
 
@@ -56,9 +75,11 @@ pub struct UmlsKernel<const D: usize, W: WeightFunction = CubicBSpline> {
 }
 
 impl<const D: usize> UmlsKernel<D, CubicBSpline> {
-    /// The paper's kernel: cubic B-spline distance weights, per-vertex radii (factor 1).
+    /// The default kernel: the paper's cubic B-spline distance weights with the
+    /// incident-edge radius of [`SupportRadius::default`].
     pub fn new(mesh: &SimplexMesh<D>) -> Self {
-        Self::with_weight(mesh, CubicBSpline, SupportRadius::default()).expect("factor 1 is valid")
+        Self::with_weight(mesh, CubicBSpline, SupportRadius::default())
+            .expect("the default factor is valid")
     }
 }
 
@@ -69,9 +90,10 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
         weight: W,
         support: SupportRadius,
     ) -> Result<Self, MlsError> {
-        let (factor, global) = match support {
-            SupportRadius::PerVertex { factor } => (factor, false),
-            SupportRadius::Global { factor } => (factor, true),
+        let factor = match support {
+            SupportRadius::PerVertex { factor }
+            | SupportRadius::IncidentEdge { factor }
+            | SupportRadius::Global { factor } => factor,
         };
         if !(factor.is_finite() && factor > 0.0) {
             return Err(MlsError::InvalidParameter {
@@ -80,21 +102,39 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
                 reason: "must be finite and positive",
             });
         }
-        let radii = if global {
-            vec![factor * mesh.max_edge_length(); mesh.vertex_count()]
-        } else {
-            let mut reach = vec![0.0f64; mesh.vertex_count()];
-            for s in 0..mesh.simplex_count() {
-                let host = mesh.simplex(s);
-                for &v in mesh.topology().one_ring(s).vertices {
-                    let xv = mesh.vertex(v as usize);
-                    for &n in host {
-                        reach[v as usize] =
-                            reach[v as usize].max((mesh.vertex(n as usize) - xv).norm());
+        let radii = match support {
+            SupportRadius::Global { .. } => {
+                vec![factor * mesh.max_edge_length(); mesh.vertex_count()]
+            }
+            SupportRadius::IncidentEdge { .. } => {
+                let mut longest = vec![0.0f64; mesh.vertex_count()];
+                for s in 0..mesh.simplex_count() {
+                    let simplex = mesh.simplex(s);
+                    for (i, &a) in simplex.iter().enumerate() {
+                        for &b in &simplex[i + 1..] {
+                            let length = (mesh.vertex(a as usize) - mesh.vertex(b as usize)).norm();
+                            for v in [a, b] {
+                                longest[v as usize] = longest[v as usize].max(length);
+                            }
+                        }
                     }
                 }
+                longest.iter().map(|l| factor * l).collect()
             }
-            reach.iter().map(|r| factor * r).collect()
+            SupportRadius::PerVertex { .. } => {
+                let mut reach = vec![0.0f64; mesh.vertex_count()];
+                for s in 0..mesh.simplex_count() {
+                    let host = mesh.simplex(s);
+                    for &v in mesh.topology().one_ring(s).vertices {
+                        let xv = mesh.vertex(v as usize);
+                        for &n in host {
+                            reach[v as usize] =
+                                reach[v as usize].max((mesh.vertex(n as usize) - xv).norm());
+                        }
+                    }
+                }
+                reach.iter().map(|r| factor * r).collect()
+            }
         };
         Ok(Self {
             radii,

@@ -53,3 +53,26 @@ impl WeightFunction for WendlandC2 {
         }
     }
 }
+
+/// A weight profile chosen at run time (a scene file names it): either of the two
+/// provided profiles, behind one type so a kernel's type does not change with the choice.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Profile {
+    /// [`CubicBSpline`], the paper's.
+    #[default]
+    CubicBSpline,
+    /// [`WendlandC2`].
+    WendlandC2,
+}
+
+impl WeightFunction for Profile {
+    const SUPPORT: f64 = 2.0;
+
+    #[inline]
+    fn evaluate(&self, r: f64) -> (f64, f64) {
+        match self {
+            Profile::CubicBSpline => CubicBSpline.evaluate(r),
+            Profile::WendlandC2 => WendlandC2.evaluate(r),
+        }
+    }
+}

@@ -4,8 +4,8 @@
 use nalgebra::{Vector1, Vector2};
 use umls_mesh::generate::{Diagonal, Lattice};
 use umls_mls::{
-    Conditioning, GradientKind, IllConditionedPolicy, Linear, MlsError, Quadratic, Stencil,
-    SupportRadius, UmlsKernel, WendlandC2,
+    Conditioning, CubicBSpline, DEFAULT_SUPPORT_FACTOR, GradientKind, IllConditionedPolicy, Linear,
+    MlsError, Quadratic, Stencil, SupportRadius, UmlsKernel, WeightFunction, WendlandC2,
 };
 
 /// At the end vertex of a 1D mesh only two samples carry weight (η of the third vanishes),
@@ -201,21 +201,53 @@ fn kernel_error_paths() {
     ));
 }
 
-/// Per-vertex radii keep every stencil distance within r ≤ 1 (so d_v ≥ W(1) > 0); the
-/// global rule uses the longest edge.
+/// The per-vertex reach keeps every stencil distance within r ≤ 1 (so d_v ≥ W(1) > 0);
+/// the incident-edge rule (the default) reaches every vertex of every simplex a vertex
+/// belongs to within its support 2h_v, so host vertices always weigh; the global rule
+/// uses the longest edge.
 #[test]
 fn support_radii_cover_every_stencil() {
     let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [6, 6])
         .jitter(0.2, 8)
         .triangles(Diagonal::Crossed)
         .unwrap();
-    let kernel = UmlsKernel::new(&mesh);
+    let reach = UmlsKernel::with_weight(
+        &mesh,
+        CubicBSpline,
+        SupportRadius::PerVertex { factor: 1.0 },
+    )
+    .unwrap();
     for s in 0..mesh.simplex_count() {
         for &v in mesh.topology().one_ring(s).vertices {
             for &n in mesh.simplex(s) {
                 let d = (mesh.vertex(v as usize) - mesh.vertex(n as usize)).norm();
-                assert!(d <= kernel.support_radii()[v as usize] * (1.0 + 1e-12));
+                assert!(d <= reach.support_radii()[v as usize] * (1.0 + 1e-12));
             }
+        }
+    }
+    let incident = UmlsKernel::new(&mesh);
+    assert_eq!(
+        SupportRadius::default(),
+        SupportRadius::IncidentEdge {
+            factor: DEFAULT_SUPPORT_FACTOR
+        }
+    );
+    for s in 0..mesh.simplex_count() {
+        let simplex = mesh.simplex(s);
+        for &v in simplex {
+            let h = incident.support_radii()[v as usize];
+            let longest = simplex
+                .iter()
+                .map(|&n| (mesh.vertex(v as usize) - mesh.vertex(n as usize)).norm())
+                .fold(0.0, f64::max);
+            assert!(
+                longest <= h / DEFAULT_SUPPORT_FACTOR * (1.0 + 1e-12),
+                "vertex {v}"
+            );
+            // So the distance weight of a host vertex is positive all over its host.
+            assert!(CubicBSpline.evaluate(longest / h).0 > 0.0, "vertex {v}");
+            // And narrower than the reach: farther ring vertices fade out.
+            assert!(h <= DEFAULT_SUPPORT_FACTOR * reach.support_radii()[v as usize]);
         }
     }
     let global =

@@ -13,7 +13,10 @@ use std::collections::BTreeMap;
 use nalgebra::SVector;
 use umls_mesh::SimplexMesh;
 use umls_mesh::generate::{Diagonal, Lattice};
-use umls_mls::{GradientKind, Linear, PolynomialBasis, Quadratic, Stencil, UmlsKernel};
+use umls_mls::{
+    CubicBSpline, GradientKind, Linear, PolynomialBasis, Profile, Quadratic, Stencil,
+    SupportRadius, UmlsKernel, WeightFunction,
+};
 
 const EPS: f64 = 1e-4;
 
@@ -78,11 +81,14 @@ fn facet_jumps<const D: usize>(
     (at(EPS), at(2.0 * EPS))
 }
 
-fn umls_evaluator<'a, const D: usize, const N: usize, B: PolynomialBasis<D, N>>(
+fn umls_evaluator<'a, const D: usize, const N: usize, B: PolynomialBasis<D, N>, W>(
     mesh: &'a SimplexMesh<D>,
-    kernel: &'a UmlsKernel<D>,
+    kernel: &'a UmlsKernel<D, W>,
     gradient: GradientKind,
-) -> Box<Evaluator<'a, D>> {
+) -> Box<Evaluator<'a, D>>
+where
+    W: WeightFunction,
+{
     Box::new(move |s, x| {
         let mut st = Stencil::new();
         kernel
@@ -220,14 +226,14 @@ fn umls_values_and_reconstructed_gradients_are_continuous() {
         "1D linear",
         &survey(
             &line,
-            &*umls_evaluator::<1, 2, Linear>(&line, &k1, GradientKind::Reconstructed),
+            &*umls_evaluator::<1, 2, Linear, _>(&line, &k1, GradientKind::Reconstructed),
         ),
     );
     assert_continuous(
         "1D quadratic",
         &survey(
             &line,
-            &*umls_evaluator::<1, 3, Quadratic>(&line, &k1, GradientKind::Reconstructed),
+            &*umls_evaluator::<1, 3, Quadratic, _>(&line, &k1, GradientKind::Reconstructed),
         ),
     );
     for mesh in meshes_2d() {
@@ -236,7 +242,7 @@ fn umls_values_and_reconstructed_gradients_are_continuous() {
             "2D linear",
             &survey(
                 &mesh,
-                &*umls_evaluator::<2, 3, Linear>(&mesh, &k2, GradientKind::Reconstructed),
+                &*umls_evaluator::<2, 3, Linear, _>(&mesh, &k2, GradientKind::Reconstructed),
             ),
         );
     }
@@ -250,7 +256,80 @@ fn umls_values_and_reconstructed_gradients_are_continuous() {
         "3D linear",
         &survey(
             &tets,
-            &*umls_evaluator::<3, 4, Linear>(&tets, &k3, GradientKind::Reconstructed),
+            &*umls_evaluator::<3, 4, Linear, _>(&tets, &k3, GradientKind::Reconstructed),
+        ),
+    );
+}
+
+/// Every UMLS variant the CLI names (docs/umls-kernel.md): the wide per-vertex reach,
+/// the paper's global radius, Wendland weights, and the quadratic basis with its ridge,
+/// in 2D and 3D. Narrow supports make vertices enter and leave by their distance weight
+/// too; that weight is C² in x, so continuity holds as for the default.
+#[test]
+fn every_umls_variant_is_continuous() {
+    let variants = [
+        (
+            "wide",
+            Profile::CubicBSpline,
+            SupportRadius::PerVertex { factor: 1.0 },
+        ),
+        (
+            "paper",
+            Profile::CubicBSpline,
+            SupportRadius::Global { factor: 1.0 },
+        ),
+        ("wendland", Profile::WendlandC2, SupportRadius::default()),
+        (
+            "narrow",
+            Profile::CubicBSpline,
+            SupportRadius::IncidentEdge { factor: 0.6 },
+        ),
+    ];
+    let tets = Lattice::new([0.0; 3], [1.0; 3], [3, 3, 3])
+        .jitter(0.2, 9)
+        .rotate_about([1.0, 1.0, 0.0], 0.4)
+        .tetrahedra()
+        .unwrap();
+    for (label, profile, support) in variants {
+        for mesh in meshes_2d() {
+            let k = UmlsKernel::with_weight(&mesh, profile, support).unwrap();
+            assert_continuous(
+                &format!("2D {label}"),
+                &survey(
+                    &mesh,
+                    &*umls_evaluator::<2, 3, Linear, _>(&mesh, &k, GradientKind::Reconstructed),
+                ),
+            );
+        }
+        let k = UmlsKernel::with_weight(&tets, profile, support).unwrap();
+        assert_continuous(
+            &format!("3D {label}"),
+            &survey(
+                &tets,
+                &*umls_evaluator::<3, 4, Linear, _>(&tets, &k, GradientKind::Reconstructed),
+            ),
+        );
+    }
+    // The quadratic basis with the ridge the CLI's `umls-quadratic` uses: solvable on
+    // wall and corner vertices, and continuous because the ridge is always on.
+    for mesh in meshes_2d() {
+        let mut k = UmlsKernel::new(&mesh);
+        k.conditioning.higher_order_ridge = 1e-3;
+        assert_continuous(
+            "2D quadratic with ridge",
+            &survey(
+                &mesh,
+                &*umls_evaluator::<2, 6, Quadratic, _>(&mesh, &k, GradientKind::Reconstructed),
+            ),
+        );
+    }
+    let mut k = UmlsKernel::<3, CubicBSpline>::new(&tets);
+    k.conditioning.higher_order_ridge = 1e-3;
+    assert_continuous(
+        "3D quadratic with ridge",
+        &survey(
+            &tets,
+            &*umls_evaluator::<3, 10, Quadratic, _>(&tets, &k, GradientKind::Reconstructed),
         ),
     );
 }
@@ -288,7 +367,7 @@ fn full_umls_gradient_jumps_across_facets() {
         let k = UmlsKernel::new(&mesh);
         let s = survey(
             &mesh,
-            &*umls_evaluator::<2, 3, Linear>(&mesh, &k, GradientKind::Full),
+            &*umls_evaluator::<2, 3, Linear, _>(&mesh, &k, GradientKind::Full),
         );
         eprintln!("2D full gradient: {s:?}");
         assert!(s.value_jump < 20.0 * EPS && s.min_value_ratio > 1.9);

@@ -6,9 +6,33 @@ mod common;
 use nalgebra::{SMatrix, SVector};
 use proptest::prelude::*;
 use umls_mesh::SimplexMesh;
-use umls_mls::{GradientKind, Linear, PolynomialBasis, Quadratic, Stencil, UmlsKernel};
+use umls_mls::{
+    GradientKind, Linear, PolynomialBasis, Profile, Quadratic, Stencil, SupportRadius, UmlsKernel,
+};
 
-/// Σ N_v = 1, Σ ∇N_v = 0, Σ N_v x_v = x, Σ x_v ∇N_vᵀ = I, for the linear basis.
+/// The UMLS variants the CLI names (docs/umls-kernel.md): profile and radius rule.
+const VARIANTS: [(Profile, SupportRadius); 5] = [
+    (
+        Profile::CubicBSpline,
+        SupportRadius::IncidentEdge { factor: 0.9 },
+    ),
+    (
+        Profile::CubicBSpline,
+        SupportRadius::PerVertex { factor: 1.0 },
+    ),
+    (Profile::CubicBSpline, SupportRadius::Global { factor: 1.0 }),
+    (
+        Profile::WendlandC2,
+        SupportRadius::IncidentEdge { factor: 0.9 },
+    ),
+    (
+        Profile::CubicBSpline,
+        SupportRadius::IncidentEdge { factor: 0.6 },
+    ),
+];
+
+/// Σ N_v = 1, Σ ∇N_v = 0, Σ N_v x_v = x, Σ x_v ∇N_vᵀ = I, for the linear basis and the
+/// default kernel.
 fn check_linear<const D: usize, const N: usize>(
     mesh: &SimplexMesh<D>,
     s: usize,
@@ -18,11 +42,23 @@ fn check_linear<const D: usize, const N: usize>(
 where
     Linear: PolynomialBasis<D, N>,
 {
-    let kernel = UmlsKernel::new(mesh);
+    let kernel =
+        UmlsKernel::with_weight(mesh, Profile::CubicBSpline, SupportRadius::default()).unwrap();
+    check_linear_with::<D, N, Linear>(&kernel, mesh, s, raw, gradient)
+}
+
+/// The same for any kernel and basis containing the linear monomials.
+fn check_linear_with<const D: usize, const N: usize, B: PolynomialBasis<D, N>>(
+    kernel: &UmlsKernel<D, Profile>,
+    mesh: &SimplexMesh<D>,
+    s: usize,
+    raw: &[f64],
+    gradient: GradientKind,
+) -> Result<(), TestCaseError> {
     let x = common::point_in(mesh, s, raw);
     let mut st = Stencil::new();
     kernel
-        .evaluate::<N, Linear>(mesh, s as u32, &x, gradient, &mut st)
+        .evaluate::<N, B>(mesh, s as u32, &x, gradient, &mut st)
         .unwrap();
     let h = mesh.max_edge_length();
     let sum: f64 = st.values().iter().sum();
@@ -152,5 +188,31 @@ proptest! {
         let s = interior[s % interior.len()];
         check_quadratic::<3, 10>(&mesh, s, &raw, GradientKind::Reconstructed)?;
         check_quadratic::<3, 10>(&mesh, s, &raw, GradientKind::Full)?;
+    }
+
+    /// Every named variant reproduces linear fields on every host, boundary hosts
+    /// included; so does the quadratic basis with its ridge (the ridge penalises only
+    /// quadratic coefficients, which a linear field does not have).
+    #[test]
+    fn every_variant_reproduces_linear_fields(
+        mesh in common::rectangle(),
+        cube in common::cuboid(),
+        s in any::<usize>(),
+        v in 0..VARIANTS.len(),
+        raw in raw_weights(),
+    ) {
+        let (profile, support) = VARIANTS[v];
+        let k2 = UmlsKernel::with_weight(&mesh, profile, support).unwrap();
+        let s2 = s % mesh.simplex_count();
+        check_linear_with::<2, 3, Linear>(&k2, &mesh, s2, &raw, GradientKind::Reconstructed)?;
+        let k3 = UmlsKernel::with_weight(&cube, profile, support).unwrap();
+        let s3 = s % cube.simplex_count();
+        check_linear_with::<3, 4, Linear>(&k3, &cube, s3, &raw, GradientKind::Reconstructed)?;
+        let mut ridge = k2.clone();
+        ridge.conditioning.higher_order_ridge = 1e-3;
+        check_linear_with::<2, 6, Quadratic>(&ridge, &mesh, s2, &raw, GradientKind::Reconstructed)?;
+        let mut ridge = k3.clone();
+        ridge.conditioning.higher_order_ridge = 1e-3;
+        check_linear_with::<3, 10, Quadratic>(&ridge, &cube, s3, &raw, GradientKind::Reconstructed)?;
     }
 }
