@@ -51,15 +51,20 @@ def sphere_container():
     gmsh.model.mesh.generate(3)
 
 
+def box_of_tetrahedra(size, dimensions, group):
+    """The box [0, dimensions] of tetrahedra of `size`, one physical group `group`."""
+    box = gmsh.model.occ.addBox(0, 0, 0, *dimensions)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMin", size)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+    gmsh.model.addPhysicalGroup(3, [box], name=group)
+    gmsh.model.mesh.generate(3)
+
+
 def slope_box():
     """The box [0, 4] x [0, 0.4] x [0, 1.5] the slope of `slope-3d.toml` collapses in,
     tetrahedra of size 0.13 (the walls are planes of the scene file)."""
-    box = gmsh.model.occ.addBox(0, 0, 0, 4.0, 0.4, 1.5)
-    gmsh.model.occ.synchronize()
-    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.13)
-    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.13)
-    gmsh.model.addPhysicalGroup(3, [box], name="box")
-    gmsh.model.mesh.generate(3)
+    box_of_tetrahedra(0.13, (4.0, 0.4, 1.5), "box")
 
 
 def column():
@@ -75,12 +80,7 @@ def column():
 def column_3d():
     """The box [0, 1] x [0, 1] x [0, 4.4] of the 3D hydrostatic column, tetrahedra of
     size 0.2 (the lattice scene's cell)."""
-    box = gmsh.model.occ.addBox(0, 0, 0, 1.0, 1.0, 4.4)
-    gmsh.model.occ.synchronize()
-    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.2)
-    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.2)
-    gmsh.model.addPhysicalGroup(3, [box], name="box")
-    gmsh.model.mesh.generate(3)
+    box_of_tetrahedra(0.2, (1.0, 1.0, 4.4), "box")
 
 
 mesh("cantilever", cantilever)
