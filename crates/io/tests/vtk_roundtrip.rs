@@ -225,3 +225,39 @@ fn histories_read_back_with_their_header() {
     assert_eq!(read, rows.iter().map(|r| r.to_vec()).collect::<Vec<_>>());
     assert!(HistoryWriter::create(scratch("bad.csv"), &["a,b"]).is_err());
 }
+
+/// The binary writer streams base64 in chunks of 12 kB: arrays many chunks long, of every
+/// length modulo 3 bytes (the header is 8 bytes, values 8, 4 or 1), read back bit for bit.
+#[test]
+fn large_frames_stream_and_read_back_exactly() {
+    for n in [4999usize, 5000, 5001] {
+        let x: Vec<[f64; 3]> = (0..n)
+            .map(|i| {
+                let t = i as f64;
+                [t / 7.0, (t * 0.37).sin(), -t * 1e-9]
+            })
+            .collect();
+        let ids: Vec<i32> = (0..n as i32).map(|i| i * 7919 % 1013 - 500).collect();
+        let mut grid = UnstructuredGrid::point_cloud(x);
+        grid.add_point_ids("material", ids.clone()).unwrap();
+        for encoding in [Encoding::Binary, Encoding::Ascii] {
+            let path = scratch(&format!("large-{n}-{encoding:?}.vtu"));
+            grid.write_vtu(&path, encoding).unwrap();
+            // The file is the in-memory document.
+            assert_eq!(
+                std::fs::read_to_string(&path).unwrap(),
+                grid.to_vtu(encoding)
+            );
+            let (points, connectivity, offsets, types, data, _) = read_back(&path);
+            let expected: Vec<u64> = grid.points.iter().flatten().map(|x| x.to_bits()).collect();
+            assert_eq!(
+                points.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                expected
+            );
+            assert_eq!(connectivity, grid.connectivity);
+            assert_eq!(offsets, grid.offsets);
+            assert_eq!(types, vec![1u8; n]);
+            assert_eq!(data[0].2.clone().into_vec::<i32>().unwrap(), ids);
+        }
+    }
+}
