@@ -8,7 +8,9 @@
 
 use std::sync::Arc;
 
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+mod common;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::{SVector, Vector3};
 use umls::constitutive::WeaklyCompressibleFluid;
 use umls::engine::{Apic, Particles, Simulation, StepSettings, Wall, WallKind, lattice_points};
@@ -57,16 +59,7 @@ fn bench<K: Kernel<3> + Clone>(c: &mut Criterion, name: &str, kernel: K) {
     let mut g = c.benchmark_group("fluid_box_3d_64k");
     g.throughput(Throughput::Elements(64_000));
     g.sample_size(10);
-    for threads in [1usize, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("pool");
-        let mut sim = scene(kernel.clone());
-        g.bench_function(BenchmarkId::new(name, format!("{threads}thread")), |b| {
-            b.iter(|| pool.install(|| sim.step().expect("stable")))
-        });
-    }
+    common::step_with_threads(&mut g, name, || scene(kernel.clone()));
     g.finish();
 }
 

@@ -6,7 +6,9 @@
 
 use std::sync::Arc;
 
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+mod common;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::SVector;
 use umls::constitutive::{ElasticParameters, NeoHookean};
 use umls::engine::{Particles, Pic, Simulation, StepSettings};
@@ -48,26 +50,18 @@ fn bench_kernel<const D: usize, K: Kernel<D> + Clone>(
     let mut g = c.benchmark_group(group);
     g.throughput(Throughput::Elements(count as u64));
     g.sample_size(10);
-    for threads in [1usize, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("pool");
-        // USL, the engine's default, for every kernel: the grid update's mass scaling
-        // keeps nodes barely covered by material (tiny mass, large f/m) stable.
-        let settings = StepSettings::new(1e-5);
-        let mut sim = Simulation::new(
+    // USL, the engine's default, for every kernel: the grid update's mass scaling
+    // keeps nodes barely covered by material (tiny mass, large f/m) stable.
+    common::step_with_threads(&mut g, name, || {
+        Simulation::new(
             kernel.clone(),
             material,
             Pic,
             particles::<D, K::Cache>(per_axis),
-            settings,
+            StepSettings::new(1e-5),
         )
-        .expect("valid");
-        g.bench_function(BenchmarkId::new(name, format!("{threads}thread")), |b| {
-            b.iter(|| pool.install(|| sim.step().expect("stable")))
-        });
-    }
+        .expect("valid")
+    });
     g.finish();
 }
 
