@@ -97,7 +97,6 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
         crate::grid::ReactionScratch<D>,
         Vec<crate::boundary::Reaction<D>>,
     ),
-    updates: Vec<ParticleUpdate<D>>,
     velocity_gradients: Vec<SMatrix<f64, D, D>>,
 }
 
@@ -216,7 +215,6 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             times: StageTimes::default(),
             stress_buffer: Vec::new(),
             reactions: Default::default(),
-            updates: Vec::new(),
             velocity_gradients: Vec::new(),
             grid,
         })
@@ -596,57 +594,51 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     fn grid_to_particles(&mut self, dt: f64) {
         let (kernel, transfer, stencils) = (&self.kernel, self.transfer, &self.stencils);
         let (old_v, new_v) = (&self.grid.velocity, &self.grid.new_velocity);
-        let positions = &self.particles.position;
-        let velocities = &self.particles.velocity;
-        let mut updates = std::mem::take(&mut self.updates);
         let moment_scale = kernel.constant_second_moment();
         let constant_moment = moment_scale.map(|s| SMatrix::<f64, D, D>::identity() * s);
-        (0..self.particles.len())
-            .into_par_iter()
-            .with_min_len(crate::stencils::CHUNK)
-            .map(|i| {
-                let x = positions[i];
-                let mut pic = SVector::<f64, D>::zeros();
-                let mut flip = SVector::<f64, D>::zeros();
-                let mut grad_v = SMatrix::<f64, D, D>::zeros();
-                let mut b = SMatrix::<f64, D, D>::zeros();
-                let mut d = constant_moment.unwrap_or_else(SMatrix::zeros);
-                let st = stencils.of(i);
-                for e in 0..st.len() {
-                    let node = st.nodes[e] as usize;
-                    let n = st.values[e];
-                    pic += new_v[node] * n;
-                    flip += (new_v[node] - old_v[node]) * n;
-                    grad_v += new_v[node] * st.gradients[e].transpose();
-                    if T::AFFINE && (T::USES_MOMENTS || constant_moment.is_none()) {
-                        let r = kernel.node_position(node) - x;
-                        if constant_moment.is_none() {
-                            d += r * r.transpose() * n;
-                        }
-                        if T::USES_MOMENTS {
-                            b += new_v[node] * r.transpose() * n;
-                        }
+        // One particle's G2P from its stencil; evaluated inside the write-back below, so
+        // the results go straight to the particle arrays (no per-particle buffer).
+        let gather = |i: usize, x: SVector<f64, D>, old: &SVector<f64, D>| {
+            let mut pic = SVector::<f64, D>::zeros();
+            let mut flip = SVector::<f64, D>::zeros();
+            let mut grad_v = SMatrix::<f64, D, D>::zeros();
+            let mut b = SMatrix::<f64, D, D>::zeros();
+            let mut d = constant_moment.unwrap_or_else(SMatrix::zeros);
+            let st = stencils.of(i);
+            for e in 0..st.len() {
+                let node = st.nodes[e] as usize;
+                let n = st.values[e];
+                pic += new_v[node] * n;
+                flip += (new_v[node] - old_v[node]) * n;
+                grad_v += new_v[node] * st.gradients[e].transpose();
+                if T::AFFINE && (T::USES_MOMENTS || constant_moment.is_none()) {
+                    let r = kernel.node_position(node) - x;
+                    if constant_moment.is_none() {
+                        d += r * r.transpose() * n;
+                    }
+                    if T::USES_MOMENTS {
+                        b += new_v[node] * r.transpose() * n;
                     }
                 }
-                let affine = match moment_scale {
-                    Some(s) => transfer.affine_with_constant_moment(&b, s, &grad_v),
-                    None => transfer.affine(&b, &d, &grad_v),
-                };
-                ParticleUpdate {
-                    velocity: transfer.velocity(&velocities[i], &pic, &flip),
-                    position: x + pic * dt,
-                    affine_moment: if T::AFFINE {
-                        (affine * d * affine.transpose()).trace()
-                    } else {
-                        0.0
-                    },
-                    affine,
-                    velocity_gradient: grad_v,
-                }
-            })
-            .collect_into_vec(&mut updates);
+            }
+            let affine = match moment_scale {
+                Some(s) => transfer.affine_with_constant_moment(&b, s, &grad_v),
+                None => transfer.affine(&b, &d, &grad_v),
+            };
+            ParticleUpdate {
+                velocity: transfer.velocity(old, &pic, &flip),
+                position: x + pic * dt,
+                affine_moment: if T::AFFINE {
+                    (affine * d * affine.transpose()).trace()
+                } else {
+                    0.0
+                },
+                affine,
+                velocity_gradient: grad_v,
+            }
+        };
         let mut velocity_gradients = std::mem::take(&mut self.velocity_gradients);
-        velocity_gradients.resize(updates.len(), SMatrix::zeros());
+        velocity_gradients.resize(self.particles.len(), SMatrix::zeros());
         let p = &mut self.particles;
         let (gravity, time) = (self.settings.gravity_at(self.time), self.time);
         let body_force = self.body_force.as_ref();
@@ -663,10 +655,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .zip(p.affine.par_chunks_mut(chunk))
             .zip(p.affine_moment.par_chunks_mut(chunk))
             .zip(velocity_gradients.par_chunks_mut(chunk))
-            .zip(updates.par_chunks(chunk))
             .enumerate()
             .map(
-                |(c, (((((velocity, position), affine), moment), gradient), update))| {
+                |(c, ((((velocity, position), affine), moment), gradient))| {
                     // Work of gravity and body forces with the mean of old and new velocity:
                     // the trapezoidal rule balances the kinetic energy of a free fall exactly.
                     let mut power = 0.0;
@@ -674,8 +665,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     // can differ from the stored one): the Courant check reads it.
                     let mut longest = (0, 0.0f64);
                     let mut corrections = 0;
-                    for k in 0..update.len() {
-                        let (i, u) = (c * chunk + k, &update[k]);
+                    for k in 0..velocity.len() {
+                        let i = c * chunk + k;
+                        let u = &gather(i, position[k], &velocity[k]);
                         let acceleration =
                             body_force.map_or(gravity, |b| gravity + b(&position[k], time));
                         power += p.mass[i] * acceleration.dot(&(velocity[k] + u.velocity)) * 0.5;
@@ -719,7 +711,6 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         }
         self.totals.external_work += power * dt;
         self.totals.longest_move = longest;
-        self.updates = updates;
         self.velocity_gradients = velocity_gradients;
     }
 
