@@ -69,14 +69,9 @@ pub struct RunReport {
 /// What differs between dimensions: the UMLS kernel type, the lattice split, and
 /// whether plastic models exist.
 trait Dimension<const D: usize> {
-    type Umls: Kernel<D>;
-    type UmlsQuadratic: Kernel<D>;
+    type Umls: Kernel<D> + FromMls<D>;
+    type UmlsQuadratic: Kernel<D> + FromMls<D>;
     const SPLIT: Split<D>;
-    fn umls(mesh: Arc<SimplexMesh<D>>, mls: UmlsKernel<D, Profile>) -> Self::Umls;
-    fn umls_quadratic(
-        mesh: Arc<SimplexMesh<D>>,
-        mls: UmlsKernel<D, Profile>,
-    ) -> Self::UmlsQuadratic;
     fn run_plastic<K: Kernel<D>>(ctx: &Context<'_, D>, kernel: K) -> Result<RunReport>;
 }
 
@@ -88,15 +83,6 @@ impl Dimension<1> for D1 {
     type Umls = UmlsMeshKernel<1, 2, Linear, Profile>;
     type UmlsQuadratic = UmlsMeshKernel<1, 3, Quadratic, Profile>;
     const SPLIT: Split<1> = setup::segments;
-    fn umls(mesh: Arc<SimplexMesh<1>>, mls: UmlsKernel<1, Profile>) -> Self::Umls {
-        UmlsMeshKernel::with_kernel(mesh, mls)
-    }
-    fn umls_quadratic(
-        mesh: Arc<SimplexMesh<1>>,
-        mls: UmlsKernel<1, Profile>,
-    ) -> Self::UmlsQuadratic {
-        UmlsMeshKernel::with_kernel(mesh, mls)
-    }
     fn run_plastic<K: Kernel<1>>(ctx: &Context<'_, 1>, _: K) -> Result<RunReport> {
         Err(setup::plastic_in_1d(ctx.scene))
     }
@@ -106,15 +92,6 @@ impl Dimension<2> for D2 {
     type Umls = UmlsMeshKernel<2, 3, Linear, Profile>;
     type UmlsQuadratic = UmlsMeshKernel<2, 6, Quadratic, Profile>;
     const SPLIT: Split<2> = setup::triangles;
-    fn umls(mesh: Arc<SimplexMesh<2>>, mls: UmlsKernel<2, Profile>) -> Self::Umls {
-        UmlsMeshKernel::with_kernel(mesh, mls)
-    }
-    fn umls_quadratic(
-        mesh: Arc<SimplexMesh<2>>,
-        mls: UmlsKernel<2, Profile>,
-    ) -> Self::UmlsQuadratic {
-        UmlsMeshKernel::with_kernel(mesh, mls)
-    }
     fn run_plastic<K: Kernel<2>>(ctx: &Context<'_, 2>, kernel: K) -> Result<RunReport> {
         with_material(
             ctx,
@@ -130,15 +107,6 @@ impl Dimension<3> for D3 {
     type Umls = UmlsMeshKernel<3, 4, Linear, Profile>;
     type UmlsQuadratic = UmlsMeshKernel<3, 10, Quadratic, Profile>;
     const SPLIT: Split<3> = setup::tetrahedra;
-    fn umls(mesh: Arc<SimplexMesh<3>>, mls: UmlsKernel<3, Profile>) -> Self::Umls {
-        UmlsMeshKernel::with_kernel(mesh, mls)
-    }
-    fn umls_quadratic(
-        mesh: Arc<SimplexMesh<3>>,
-        mls: UmlsKernel<3, Profile>,
-    ) -> Self::UmlsQuadratic {
-        UmlsMeshKernel::with_kernel(mesh, mls)
-    }
     fn run_plastic<K: Kernel<3>>(ctx: &Context<'_, 3>, kernel: K) -> Result<RunReport> {
         with_material(
             ctx,
@@ -147,6 +115,18 @@ impl Dimension<3> for D3 {
                 models: ctx.setup.models.clone(),
             },
         )
+    }
+}
+
+/// A UMLS kernel type built from a mesh and MLS settings: what `Dimension` names per
+/// dimension is only the basis size, the construction is the same for all.
+trait FromMls<const D: usize> {
+    fn from_mls(mesh: Arc<SimplexMesh<D>>, mls: UmlsKernel<D, Profile>) -> Self;
+}
+
+impl<const D: usize, const N: usize, B> FromMls<D> for UmlsMeshKernel<D, N, B, Profile> {
+    fn from_mls(mesh: Arc<SimplexMesh<D>>, mls: UmlsKernel<D, Profile>) -> Self {
+        Self::with_kernel(mesh, mls)
     }
 }
 
@@ -229,12 +209,12 @@ fn run_dim<const D: usize, X: Dimension<D>>(
         | KernelKind::UmlsPaper => {
             let mesh = mesh()?;
             let mls = umls_settings(&ctx, &mesh)?;
-            with_kernel::<D, X, _>(&ctx, X::umls(mesh, mls))
+            with_kernel::<D, X, _>(&ctx, X::Umls::from_mls(mesh, mls))
         }
         KernelKind::UmlsQuadratic => {
             let mesh = mesh()?;
             let mls = umls_settings(&ctx, &mesh)?;
-            with_kernel::<D, X, _>(&ctx, X::umls_quadratic(mesh, mls))
+            with_kernel::<D, X, _>(&ctx, X::UmlsQuadratic::from_mls(mesh, mls))
         }
         KernelKind::LinearFe => with_kernel::<D, X, _>(&ctx, LinearFeKernel::new(mesh()?)),
         KernelKind::Bspline2 => {

@@ -115,8 +115,8 @@ fn locate<const D: usize>(
 ///
 /// `N` is the size of the polynomial basis `B` (D + 1 for [`Linear`], the default;
 /// (D + 1)(D + 2)/2 for [`umls_mls::Quadratic`]) and `W` the distance-weight profile.
-/// Use the aliases [`Umls1`], [`Umls2`], [`Umls3`] for the paper's kernel and
-/// [`UmlsQuadratic2`], [`UmlsQuadratic3`] for the quadratic fit.
+/// Use the aliases [`Umls1`], [`Umls2`], [`Umls3`] for the linear fit and
+/// [`UmlsQuadratic2`], [`UmlsQuadratic3`] for the quadratic one.
 #[derive(Debug, Clone)]
 pub struct UmlsMeshKernel<const D: usize, const N: usize, B = Linear, W = CubicBSpline>
 where
@@ -139,7 +139,8 @@ pub type UmlsQuadratic2 = UmlsMeshKernel<2, 6, umls_mls::Quadratic>;
 pub type UmlsQuadratic3 = UmlsMeshKernel<3, 10, umls_mls::Quadratic>;
 
 impl<const D: usize, const N: usize, B> UmlsMeshKernel<D, N, B, CubicBSpline> {
-    /// The paper's kernel (cubic B-spline distance weights, per-vertex radii) on `mesh`.
+    /// The default kernel on `mesh` ([`UmlsKernel::new`]: the paper's cubic B-spline
+    /// distance weights with the incident-edge support radius).
     pub fn new(mesh: Arc<SimplexMesh<D>>) -> Self {
         let kernel = UmlsKernel::new(&mesh);
         Self::with_kernel(mesh, kernel)

@@ -107,19 +107,18 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
                 vec![factor * mesh.max_edge_length(); mesh.vertex_count()]
             }
             SupportRadius::IncidentEdge { .. } => {
-                let mut longest = vec![0.0f64; mesh.vertex_count()];
-                for s in 0..mesh.simplex_count() {
-                    let simplex = mesh.simplex(s);
-                    for (i, &a) in simplex.iter().enumerate() {
-                        for &b in &simplex[i + 1..] {
-                            let length = (mesh.vertex(a as usize) - mesh.vertex(b as usize)).norm();
-                            for v in [a, b] {
-                                longest[v as usize] = longest[v as usize].max(length);
-                            }
-                        }
-                    }
-                }
-                longest.iter().map(|l| factor * l).collect()
+                let topology = mesh.topology();
+                (0..mesh.vertex_count())
+                    .map(|v| {
+                        let xv = mesh.vertex(v);
+                        let longest = topology
+                            .adjacent_vertices(v)
+                            .iter()
+                            .map(|&u| (mesh.vertex(u as usize) - xv).norm())
+                            .fold(0.0, f64::max);
+                        factor * longest
+                    })
+                    .collect()
             }
             SupportRadius::PerVertex { .. } => {
                 let mut reach = vec![0.0f64; mesh.vertex_count()];
