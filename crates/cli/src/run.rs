@@ -383,6 +383,21 @@ impl TransferScheme for AffineTransfer {
             Self::VelocityGradient => VelocityGradientAffine.affine(b, d, grad_v),
         }
     }
+
+    fn affine_with_constant_moment<const D: usize>(
+        &self,
+        b: &nalgebra::SMatrix<f64, D, D>,
+        s: f64,
+        grad_v: &nalgebra::SMatrix<f64, D, D>,
+    ) -> nalgebra::SMatrix<f64, D, D> {
+        // Each scheme's own closed form (APIC: B_p / s, no Cholesky factorisation).
+        match self {
+            Self::Apic => Apic.affine_with_constant_moment(b, s, grad_v),
+            Self::VelocityGradient => {
+                VelocityGradientAffine.affine_with_constant_moment(b, s, grad_v)
+            }
+        }
+    }
 }
 
 /// The typed part of a run: particles of the table's state and the kernel's cache, and
@@ -409,6 +424,7 @@ fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     settings.gravity = ctx.setup.gravity;
     settings.gravity_ramp = ctx.setup.gravity_ramp;
     settings.stress_update = ctx.setup.stress_update;
+    settings.stencil_storage = ctx.scene.spec.kernel.stencils.storage();
     settings.damping = ctx.setup.damping;
     let mut sim = Simulation::new(kernel, table, transfer, particles, settings)?;
     if let Some(field) = &ctx.setup.body_force {
@@ -458,6 +474,7 @@ pub(crate) trait Run<const D: usize> {
     fn node_count(&self) -> usize;
     fn last_dt(&self) -> f64;
     fn stage_times(&self) -> StageTimes;
+    fn memory_use(&self) -> umls_engine::MemoryUse;
     /// Cauchy stresses σ = τ / det F.
     fn cauchy_stresses(&self) -> std::result::Result<Vec<SMatrix<f64, D, D>>, EngineError>;
 }
@@ -545,6 +562,9 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
     }
     fn stage_times(&self) -> StageTimes {
         *Simulation::stage_times(self)
+    }
+    fn memory_use(&self) -> umls_engine::MemoryUse {
+        Simulation::memory_use(self)
     }
     fn cauchy_stresses(&self) -> std::result::Result<Vec<SMatrix<f64, D, D>>, EngineError> {
         let mut stresses = self.stresses()?;
@@ -855,6 +875,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         "kernel": ctx.kernel.name(),
         "transfer": transfer_name(&spec.transfer),
         "stress_update": spec.time.stress_update.name(),
+        "stencils": spec.kernel.stencils.name(),
         "materials": setup.material_names,
         "particles": sim.positions().len(),
         "nodes": sim.node_count(),
@@ -884,6 +905,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
             Some(_) => Some("other"),
         },
         "peak_memory_bytes": crate::memory::peak_resident_bytes(),
+        "engine_memory": engine_memory(&sim.memory_use()),
         "wall_time_s": wall,
         "stage_seconds": stage_seconds(&sim.stage_times()),
         "particle_steps_per_second": if wall > 0.0 { (sim.positions().len() * taken) as f64 / wall } else { 0.0 },
@@ -907,6 +929,18 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
             out: ctx.options.out.clone(),
         }),
     }
+}
+
+/// The simulation's own accounting of its memory (`Simulation::memory_use`).
+fn engine_memory(m: &umls_engine::MemoryUse) -> serde_json::Value {
+    json!({
+        "particle_state_bytes": m.particles,
+        "particle_scratch_bytes": m.particle_scratch,
+        "stored_stencil_bytes": m.stencils,
+        "node_bytes": m.nodes,
+        "bytes_per_particle": m.bytes_per_particle(),
+        "bytes_per_particle_with_stencils": m.bytes_per_particle_with_stencils(),
+    })
 }
 
 /// Seconds per stage of the step, and their share of the stepping time.

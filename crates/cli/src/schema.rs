@@ -212,6 +212,43 @@ pub struct KernelSpec {
     pub support: Option<SupportSpec>,
     /// UMLS kernels: multiplier of the support radius (default: the kernel name's).
     pub support_factor: Option<f64>,
+    /// Whether stencils are stored for the step or recomputed where used (default: the
+    /// kernel's choice, `auto`).
+    #[serde(default)]
+    pub stencils: StencilsSpec,
+}
+
+/// `kernel.stencils`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StencilsSpec {
+    /// As the kernel prefers: B-splines recompute, mesh kernels store.
+    #[default]
+    Auto,
+    /// Store every particle's stencil for the step.
+    Store,
+    /// Recompute stencils in P2G and G2P (less memory, more work).
+    Recompute,
+}
+
+impl StencilsSpec {
+    /// The name in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Store => "store",
+            Self::Recompute => "recompute",
+        }
+    }
+
+    /// The engine's setting.
+    pub fn storage(self) -> umls_engine::StencilStorage {
+        match self {
+            Self::Auto => umls_engine::StencilStorage::KernelChoice,
+            Self::Store => umls_engine::StencilStorage::Store,
+            Self::Recompute => umls_engine::StencilStorage::Recompute,
+        }
+    }
 }
 
 impl KernelKind {

@@ -82,6 +82,11 @@ pub(crate) struct ReactionScratch<const D: usize> {
 }
 
 impl<const D: usize> ReactionScratch<D> {
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        crate::memory::bytes(&self.before) + crate::memory::bytes(&self.nodal)
+    }
+
     /// Records p_i + Δt f_i of the reaction sets' nodes, before damping or constraints
     /// touch the forces.
     pub fn record(
@@ -128,6 +133,18 @@ impl<const D: usize> ReactionScratch<D> {
 }
 
 impl<const D: usize> Grid<D> {
+    /// Bytes held by the nodal fields.
+    pub fn bytes(&self) -> usize {
+        use crate::memory::bytes;
+        bytes(&self.mass)
+            + bytes(&self.abs_mass)
+            + bytes(&self.momentum)
+            + bytes(&self.force)
+            + bytes(&self.stiffness)
+            + bytes(&self.velocity)
+            + bytes(&self.new_velocity)
+    }
+
     /// Arrays for `nodes` nodes.
     pub fn new(nodes: usize, heaviest_particle: f64) -> Self {
         Self {

@@ -17,7 +17,7 @@
 use nalgebra::SVector;
 use rayon::prelude::*;
 
-use crate::stencils::Stencils;
+use crate::parallel::lowest_failure;
 
 /// Particles per block.
 pub(crate) const BLOCK: usize = 4096;
@@ -28,33 +28,43 @@ const MAX_SPAN: usize = 4;
 /// Nodes per parallel work item of the merge.
 const MERGE_CHUNK: usize = 4096;
 
+/// One node's sums in a window, kept together so that a stencil entry's contribution
+/// touches one place in memory rather than five arrays.
+#[derive(Debug, Clone, Copy)]
+struct NodeSums<const D: usize> {
+    mass: f64,
+    abs_mass: f64,
+    stiffness: f64,
+    momentum: SVector<f64, D>,
+    force: SVector<f64, D>,
+}
+
+impl<const D: usize> NodeSums<D> {
+    const ZERO: Self = Self {
+        mass: 0.0,
+        abs_mass: 0.0,
+        stiffness: 0.0,
+        momentum: SVector::from_array_storage(nalgebra::ArrayStorage([[0.0; D]; 1])),
+        force: SVector::from_array_storage(nalgebra::ArrayStorage([[0.0; D]; 1])),
+    };
+}
+
 /// One block's share of the nodal sums, over nodes `lo..lo + len`.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Window<const D: usize> {
     lo: usize,
-    mass: Vec<f64>,
-    abs_mass: Vec<f64>,
-    stiffness: Vec<f64>,
-    momentum: Vec<SVector<f64, D>>,
-    force: Vec<SVector<f64, D>>,
+    sums: Vec<NodeSums<D>>,
 }
 
 impl<const D: usize> Window<D> {
     fn reset(&mut self, lo: usize, hi: usize) {
         self.lo = lo;
-        let len = hi.saturating_sub(lo);
-        for field in [&mut self.mass, &mut self.abs_mass, &mut self.stiffness] {
-            field.clear();
-            field.resize(len, 0.0);
-        }
-        for field in [&mut self.momentum, &mut self.force] {
-            field.clear();
-            field.resize(len, SVector::zeros());
-        }
+        self.sums.clear();
+        self.sums.resize(hi.saturating_sub(lo), NodeSums::ZERO);
     }
 
     fn hi(&self) -> usize {
-        self.lo + self.mass.len()
+        self.lo + self.sums.len()
     }
 
     /// Adds one stencil entry's contributions to `node`.
@@ -68,12 +78,12 @@ impl<const D: usize> Window<D> {
         momentum: SVector<f64, D>,
         force: SVector<f64, D>,
     ) {
-        let k = node - self.lo;
-        self.mass[k] += mass;
-        self.abs_mass[k] += abs_mass;
-        self.stiffness[k] += stiffness;
-        self.momentum[k] += momentum;
-        self.force[k] += force;
+        let sums = &mut self.sums[node - self.lo];
+        sums.mass += mass;
+        sums.abs_mass += abs_mass;
+        sums.stiffness += stiffness;
+        sums.momentum += momentum;
+        sums.force += force;
     }
 }
 
@@ -99,14 +109,28 @@ pub(crate) struct Scatter<const D: usize> {
 }
 
 impl<const D: usize> Scatter<D> {
-    /// Orders the particles and cuts them into blocks.
-    fn plan(&mut self, stencils: &Stencils<D>, particles: usize, nodes: usize) {
+    /// Bytes of the particle ordering (grows with the particles) and of the blocks and
+    /// their windows (grows with the nodes).
+    pub fn bytes(&self) -> (usize, usize) {
+        use crate::memory::bytes;
+        let windows: usize = self.windows.iter().map(|w| bytes(&w.sums)).sum();
+        (
+            bytes(&self.keys) + bytes(&self.order),
+            windows + bytes(&self.windows) + bytes(&self.bounds) + bytes(&self.ranges),
+        )
+    }
+
+    /// Orders the particles by the lowest node of their stencil and cuts them into
+    /// blocks; `ranges` holds each particle's lowest and highest node.
+    fn plan(&mut self, ranges: &[(u32, u32)], nodes: usize) {
+        let particles = ranges.len();
         self.keys.clear();
-        self.keys
-            .par_extend((0..particles).into_par_iter().map(|p| {
-                let first = stencils.of(p).nodes.iter().copied().min().unwrap_or(0);
-                (first, p as u32)
-            }));
+        self.keys.par_extend(
+            ranges
+                .par_iter()
+                .enumerate()
+                .map(|(p, &(lo, _))| (lo, p as u32)),
+        );
         // Keys are unique (the index breaks ties), so the unstable sort is deterministic.
         self.keys.par_sort_unstable();
         self.order.clear();
@@ -115,8 +139,10 @@ impl<const D: usize> Scatter<D> {
         let range = |b: &[usize]| {
             let (lo, hi) = order[b[0]..b[1]]
                 .iter()
-                .flat_map(|&p| stencils.of(p as usize).nodes.iter().copied())
-                .fold((u32::MAX, 0u32), |(lo, hi), n| (lo.min(n), hi.max(n + 1)));
+                .map(|&p| ranges[p as usize])
+                .fold((u32::MAX, 0u32), |(lo, hi), (a, z)| {
+                    (lo.min(a), hi.max(z + 1))
+                });
             (lo as usize, (hi as usize).max(lo as usize))
         };
         let mut size = BLOCK;
@@ -135,32 +161,35 @@ impl<const D: usize> Scatter<D> {
         }
     }
 
-    /// Scatters every particle through `contribute(particle, window)` and sums the
-    /// windows into `sums` (every node written; nodes no particle touches get zero).
-    pub fn scatter<F>(
+    /// Scatters the particles through `contribute(block, window)`, where `block` lists
+    /// one block's particles in order, and sums the windows into `sums` (every node
+    /// written; nodes no particle touches get zero). `ranges` holds each particle's
+    /// lowest and highest stencil node. Among failing blocks the lowest particle index
+    /// wins, whatever the thread count; on failure `sums` is left as it was.
+    pub fn scatter<F, E>(
         &mut self,
-        stencils: &Stencils<D>,
-        particles: usize,
+        ranges: &[(u32, u32)],
         sums: NodalSums<'_, D>,
         contribute: F,
-    ) where
-        F: Fn(usize, &mut Window<D>) + Sync,
+    ) -> Result<(), (usize, E)>
+    where
+        F: Fn(&[u32], &mut Window<D>) -> Result<(), (usize, E)> + Sync,
+        E: Send,
     {
         let nodes = sums.mass.len();
-        self.plan(stencils, particles, nodes);
+        self.plan(ranges, nodes);
         let blocks = self.bounds.len() - 1;
         self.windows.resize_with(blocks, Window::default);
-        let (order, bounds, ranges) = (&self.order, &self.bounds, &self.ranges);
+        let (order, bounds, block_ranges) = (&self.order, &self.bounds, &self.ranges);
         self.windows
             .par_iter_mut()
             .enumerate()
-            .for_each(|(b, window)| {
-                let (lo, hi) = ranges[b];
+            .map(|(b, window)| {
+                let (lo, hi) = block_ranges[b];
                 window.reset(lo, hi);
-                for &p in &order[bounds[b]..bounds[b + 1]] {
-                    contribute(p as usize, window);
-                }
-            });
+                contribute(&order[bounds[b]..bounds[b + 1]], window)
+            })
+            .reduce(|| Ok(()), |a, b| lowest_failure(a, b, |(), ()| ()))?;
         let windows = &self.windows[..blocks];
         sums.mass
             .par_chunks_mut(MERGE_CHUNK)
@@ -182,13 +211,15 @@ impl<const D: usize> Scatter<D> {
                     let (from, to) = (w.lo.max(start), w.hi().min(end));
                     for node in from..to {
                         let (k, j) = (node - w.lo, node - start);
-                        mass[j] += w.mass[k];
-                        abs_mass[j] += w.abs_mass[k];
-                        stiffness[j] += w.stiffness[k];
-                        momentum[j] += w.momentum[k];
-                        force[j] += w.force[k];
+                        let sums = &w.sums[k];
+                        mass[j] += sums.mass;
+                        abs_mass[j] += sums.abs_mass;
+                        stiffness[j] += sums.stiffness;
+                        momentum[j] += sums.momentum;
+                        force[j] += sums.force;
                     }
                 }
             });
+        Ok(())
     }
 }

@@ -41,6 +41,20 @@ pub enum Damping {
     },
 }
 
+/// Whether the step stores every particle's stencil or evaluates it again where P2G and
+/// G2P use it. Both give the same numbers, bit for bit; they trade memory against work.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum StencilStorage {
+    /// As the kernel prefers (`Kernel::recompute_stencils`): B-splines recompute, mesh
+    /// kernels store.
+    #[default]
+    KernelChoice,
+    /// Store them for the step (memory: ≈ (4 + 8 + 8·D) bytes per stencil entry).
+    Store,
+    /// Evaluate them in P2G and G2P (three evaluations a step with the ordering pass).
+    Recompute,
+}
+
 /// Step settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepSettings<const D: usize> {
@@ -79,11 +93,14 @@ pub struct StepSettings<const D: usize> {
     /// default). A run that reads them only now and then switches it off for the steps
     /// in between; an unmeasured step leaves no reactions to read.
     pub measure_reactions: bool,
+    /// Stored or recomputed stencils.
+    pub stencil_storage: StencilStorage,
 }
 
 impl<const D: usize> StepSettings<D> {
     /// Time step `dt` (fixed), no gravity, USL, no damping, energy limit 10× checked every
-    /// 10 steps, Courant and wave Courant limits 1, cancellation fraction 10⁻³.
+    /// 10 steps, Courant and wave Courant limits 1, cancellation fraction 10⁻³, stencils
+    /// stored or recomputed as the kernel prefers.
     pub fn new(dt: f64) -> Self {
         Self {
             dt,
@@ -98,6 +115,7 @@ impl<const D: usize> StepSettings<D> {
             max_wave_courant: 1.0,
             cancellation_fraction: 1e-3,
             measure_reactions: true,
+            stencil_storage: StencilStorage::KernelChoice,
         }
     }
 

@@ -11,59 +11,21 @@ use crate::diagnostics::{Diagnostics, Totals};
 use crate::error::EngineError;
 use crate::geostatic;
 use crate::grid::Grid;
-use crate::parallel::lowest_failure;
 use crate::particles::Particles;
-use crate::settings::{Damping, StepSettings, TimeStepControl};
+use crate::settings::{Damping, StencilStorage, StepSettings, TimeStepControl};
 use crate::stencils::Stencils;
 use crate::timing::{Lap, StageTimes};
 use crate::transfer::{StressUpdate, TransferScheme};
 
+mod checks;
+mod constitutive;
+mod grid_to_particles;
+mod musl;
+mod particles_to_grid;
+
 /// A body acceleration field b(x, t), added to gravity.
 pub type BodyForce<const D: usize> =
     std::sync::Arc<dyn Fn(&SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync>;
-
-/// What G2P computes for one particle.
-#[derive(Debug, Clone, Copy)]
-struct ParticleUpdate<const D: usize> {
-    velocity: SVector<f64, D>,
-    /// Moved with the PIC velocity Σ N ṽ_i.
-    position: SVector<f64, D>,
-    affine: SMatrix<f64, D, D>,
-    affine_moment: f64,
-    velocity_gradient: SMatrix<f64, D, D>,
-}
-
-/// The affine matrix P2G spreads: C_p, scaled down if its kinetic energy at the
-/// particle's new position, tr(C D C^T) with D = Σ N r rᵀ there, exceeds what it had
-/// where G2P made it. For B-splines D is constant and nothing changes; for linear
-/// elements D goes from 0 at a vertex to its largest at the centroid, so a particle
-/// moving away from a vertex would carry the affine energy up with it — the energy
-/// source that blew up linear elements with APIC. Skipped where D is not positive
-/// (negative MLS values): there the bound means nothing.
-fn limited_affine<const D: usize, K: Kernel<D>>(
-    c: &SMatrix<f64, D, D>,
-    moment: f64,
-    stencils: &Stencils<D>,
-    i: usize,
-    kernel: &K,
-    x: &SVector<f64, D>,
-) -> SMatrix<f64, D, D> {
-    if !moment.is_finite() || moment <= 0.0 {
-        return if moment == 0.0 { SMatrix::zeros() } else { *c };
-    }
-    let mut d = SMatrix::<f64, D, D>::zeros();
-    let st = stencils.of(i);
-    for e in 0..st.len() {
-        let r = kernel.node_position(st.nodes[e] as usize) - x;
-        d += r * r.transpose() * st.values[e];
-    }
-    let now = (c * d * c.transpose()).trace();
-    if now > moment * (1.0 + 1e-9) {
-        c * (moment / now).sqrt()
-    } else {
-        *c
-    }
-}
 
 /// An MPM simulation.
 pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> {
@@ -235,6 +197,36 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         self.dt
     }
 
+    /// The bytes the simulation holds, by what they grow with (after a step, the
+    /// scratch buffers have their working size).
+    pub fn memory_use(&self) -> crate::memory::MemoryUse {
+        use crate::memory::bytes;
+        let p = &self.particles;
+        let (stored, ranges) = self.stencils.bytes();
+        let (order, windows) = self.scatter.bytes();
+        crate::memory::MemoryUse {
+            particle_count: p.len(),
+            particles: bytes(&p.position)
+                + bytes(&p.velocity)
+                + bytes(&p.affine)
+                + bytes(&p.affine_moment)
+                + bytes(&p.deformation)
+                + bytes(&p.volume)
+                + bytes(&p.mass)
+                + bytes(&p.state)
+                + bytes(&p.cache),
+            particle_scratch: bytes(&self.stress_buffer)
+                + bytes(&self.velocity_gradients)
+                + ranges
+                + order,
+            stencils: stored,
+            nodes: self.grid.bytes()
+                + windows
+                + self.reactions.0.bytes()
+                + bytes(&self.reactions.1),
+        }
+    }
+
     /// Wall time spent in each stage of [`Self::step`] so far.
     pub fn stage_times(&self) -> &StageTimes {
         &self.times
@@ -313,33 +305,6 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     })
             })
             .collect()
-    }
-
-    /// Kirchhoff stresses into the reused buffer; among failures the lowest particle
-    /// index wins, so the report does not depend on the thread count.
-    fn compute_stresses(&mut self) -> Result<(), EngineError> {
-        let (material, step, p) = (&self.material, self.step, &self.particles);
-        self.stress_buffer.resize(p.len(), SMatrix::zeros());
-        self.stress_buffer
-            .par_iter_mut()
-            .enumerate()
-            .map(|(i, stress)| -> Result<(), (usize, EngineError)> {
-                *stress = material
-                    .kirchhoff_stress(&p.deformation[i], &p.state[i])
-                    .map_err(|source| {
-                        (
-                            i,
-                            EngineError::Material {
-                                step,
-                                particle: i,
-                                source,
-                            },
-                        )
-                    })?;
-                Ok(())
-            })
-            .reduce(|| Ok(()), |a, b| lowest_failure(a, b, |(), ()| ()))
-            .map_err(|(_, e)| e)
     }
 
     /// Σ V⁰ ψ(F) over the particles (in parallel, summed in particle order).
@@ -464,10 +429,16 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             });
         }
         let mut clock = Lap::start();
-        // 1. Stencils.
+        // 1. Stencils. MUSL reads the start-of-step stencils after the particles have
+        // moved, so it needs them stored.
+        let storage = match self.settings.stress_update {
+            StressUpdate::Musl => StencilStorage::Store,
+            StressUpdate::Usl => self.settings.stencil_storage,
+        };
         self.stencils
             .compute(
                 &self.kernel,
+                storage,
                 &self.particles.position,
                 &mut self.particles.cache,
             )
@@ -480,7 +451,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // 2. Stresses, then P2G.
         self.compute_stresses()?;
         self.times.constitutive += clock.lap();
-        self.particles_to_grid();
+        self.particles_to_grid()?;
         self.times.particles_to_grid += clock.lap();
         // 3. Grid update, summing the reaction sets' forces only when they will be read.
         let measure = self.settings.measure_reactions && !self.boundary.reaction_sets.is_empty();
@@ -514,9 +485,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         }
         self.times.grid_update += clock.lap();
         // 4. G2P and walls.
-        self.grid_to_particles(dt);
+        self.grid_to_particles(dt)?;
         if self.settings.stress_update == StressUpdate::Musl {
-            self.velocity_gradients = self.musl_velocity_gradients();
+            self.musl_velocity_gradients()?;
         }
         self.times.grid_to_particles += clock.lap();
         // 5. Deformation and stress update.
@@ -535,339 +506,5 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         self.times.checks += clock.lap();
         self.times.steps += 1;
         Ok(())
-    }
-
-    /// P2G: every particle's mass, momentum and force to its stencil's nodes, through
-    /// [`crate::scatter::Scatter`] (parallel, bitwise independent of the thread count).
-    fn particles_to_grid(&mut self) {
-        let stresses = &self.stress_buffer;
-        let p = &self.particles;
-        let (stencils, kernel, time) = (&self.stencils, &self.kernel, self.time);
-        let gravity = self.settings.gravity_at(time);
-        let body_force = self.body_force.as_ref();
-        let g = &mut self.grid;
-        let sums = crate::scatter::NodalSums {
-            mass: &mut g.mass,
-            abs_mass: &mut g.abs_mass,
-            stiffness: &mut g.stiffness,
-            momentum: &mut g.momentum,
-            force: &mut g.force,
-        };
-        // With a constant second moment (B-splines) the affine energy cannot grow as a
-        // particle moves, and the limiter has nothing to do.
-        let varying_moment = kernel.constant_second_moment().is_none();
-        self.scatter.scatter(stencils, p.len(), sums, |i, window| {
-            let (m, v, x) = (p.mass[i], p.velocity[i], p.position[i]);
-            let c = match (T::AFFINE, varying_moment) {
-                (false, _) => SMatrix::zeros(),
-                (true, true) => {
-                    limited_affine(&p.affine[i], p.affine_moment[i], stencils, i, kernel, &x)
-                }
-                (true, false) => p.affine[i],
-            };
-            let volume = p.volume[i];
-            let stress_volume = stresses[i] * volume;
-            let acceleration = gravity + body_force.map_or(SVector::zeros(), |b| b(&x, time));
-            let st = stencils.of(i);
-            for e in 0..st.len() {
-                let node = st.nodes[e] as usize;
-                let n = st.values[e];
-                let gradient = st.gradients[e];
-                let mut mv = v;
-                if T::AFFINE {
-                    mv += c * (kernel.node_position(node) - x);
-                }
-                window.add(
-                    node,
-                    n * m,
-                    n.abs() * m,
-                    volume * gradient.norm_squared(),
-                    mv * (n * m),
-                    acceleration * (n * m) - stress_volume * gradient,
-                );
-            }
-        });
-    }
-
-    /// G2P: velocity, affine matrix, position, velocity gradient; then the walls. The
-    /// velocity gradients go to `self.velocity_gradients`.
-    fn grid_to_particles(&mut self, dt: f64) {
-        let (kernel, transfer, stencils) = (&self.kernel, self.transfer, &self.stencils);
-        let (old_v, new_v) = (&self.grid.velocity, &self.grid.new_velocity);
-        let moment_scale = kernel.constant_second_moment();
-        let constant_moment = moment_scale.map(|s| SMatrix::<f64, D, D>::identity() * s);
-        // One particle's G2P from its stencil; evaluated inside the write-back below, so
-        // the results go straight to the particle arrays (no per-particle buffer).
-        let gather = |i: usize, x: SVector<f64, D>, old: &SVector<f64, D>| {
-            let mut pic = SVector::<f64, D>::zeros();
-            let mut flip = SVector::<f64, D>::zeros();
-            let mut grad_v = SMatrix::<f64, D, D>::zeros();
-            let mut b = SMatrix::<f64, D, D>::zeros();
-            let mut d = constant_moment.unwrap_or_else(SMatrix::zeros);
-            let st = stencils.of(i);
-            for e in 0..st.len() {
-                let node = st.nodes[e] as usize;
-                let n = st.values[e];
-                pic += new_v[node] * n;
-                flip += (new_v[node] - old_v[node]) * n;
-                grad_v += new_v[node] * st.gradients[e].transpose();
-                if T::AFFINE && (T::USES_MOMENTS || constant_moment.is_none()) {
-                    let r = kernel.node_position(node) - x;
-                    if constant_moment.is_none() {
-                        d += r * r.transpose() * n;
-                    }
-                    if T::USES_MOMENTS {
-                        b += new_v[node] * r.transpose() * n;
-                    }
-                }
-            }
-            let affine = match moment_scale {
-                Some(s) => transfer.affine_with_constant_moment(&b, s, &grad_v),
-                None => transfer.affine(&b, &d, &grad_v),
-            };
-            ParticleUpdate {
-                velocity: transfer.velocity(old, &pic, &flip),
-                position: x + pic * dt,
-                affine_moment: if T::AFFINE {
-                    (affine * d * affine.transpose()).trace()
-                } else {
-                    0.0
-                },
-                affine,
-                velocity_gradient: grad_v,
-            }
-        };
-        let mut velocity_gradients = std::mem::take(&mut self.velocity_gradients);
-        velocity_gradients.resize(self.particles.len(), SMatrix::zeros());
-        let p = &mut self.particles;
-        let (gravity, time) = (self.settings.gravity_at(self.time), self.time);
-        let body_force = self.body_force.as_ref();
-        let (boundary, kernel) = (&self.boundary, &self.kernel);
-        let marks = boundary
-            .has_node_conditions()
-            .then(|| boundary.node_marks(self.grid.mass.len()));
-        let chunk = crate::stencils::CHUNK;
-        // In parallel over fixed chunks; the partial sums are joined in chunk order.
-        let partials: Vec<(f64, (usize, f64), usize)> = p
-            .velocity
-            .par_chunks_mut(chunk)
-            .zip(p.position.par_chunks_mut(chunk))
-            .zip(p.affine.par_chunks_mut(chunk))
-            .zip(p.affine_moment.par_chunks_mut(chunk))
-            .zip(velocity_gradients.par_chunks_mut(chunk))
-            .enumerate()
-            .map(
-                |(c, ((((velocity, position), affine), moment), gradient))| {
-                    // Work of gravity and body forces with the mean of old and new velocity:
-                    // the trapezoidal rule balances the kinetic energy of a free fall exactly.
-                    let mut power = 0.0;
-                    // The longest move (the position follows the PIC velocity, which for FLIP
-                    // can differ from the stored one): the Courant check reads it.
-                    let mut longest = (0, 0.0f64);
-                    let mut corrections = 0;
-                    for k in 0..velocity.len() {
-                        let i = c * chunk + k;
-                        let u = &gather(i, position[k], &velocity[k]);
-                        let acceleration =
-                            body_force.map_or(gravity, |b| gravity + b(&position[k], time));
-                        power += p.mass[i] * acceleration.dot(&(velocity[k] + u.velocity)) * 0.5;
-                        let moved = (u.position - position[k]).norm();
-                        if moved > longest.1 {
-                            longest = (i, moved);
-                        }
-                        velocity[k] = u.velocity;
-                        position[k] = u.position;
-                        affine[k] = u.affine;
-                        moment[k] = u.affine_moment;
-                        gradient[k] = u.velocity_gradient;
-                        if boundary.hold(&mut position[k], &mut velocity[k]) {
-                            corrections += 1;
-                        }
-                        if let Some(marks) = &marks {
-                            if let Some(exit) = kernel.domain_exit(&position[k], &p.cache[i]) {
-                                if Boundary::hold_at_facet(
-                                    marks,
-                                    &exit,
-                                    &mut position[k],
-                                    &mut velocity[k],
-                                ) {
-                                    corrections += 1;
-                                }
-                            }
-                        }
-                    }
-                    (power, longest, corrections)
-                },
-            )
-            .collect();
-        let mut power = 0.0;
-        let mut longest = (0, 0.0f64);
-        for (chunk_power, chunk_longest, corrections) in partials {
-            power += chunk_power;
-            if chunk_longest.1 > longest.1 {
-                longest = chunk_longest;
-            }
-            self.totals.wall_corrections += corrections;
-        }
-        self.totals.external_work += power * dt;
-        self.totals.longest_move = longest;
-        self.velocity_gradients = velocity_gradients;
-    }
-
-    /// F ← (I + Δt ∇v) F and the return map; the smallest density m / (V⁰ det F).
-    fn update_deformation(
-        &mut self,
-        velocity_gradients: &[SMatrix<f64, D, D>],
-        dt: f64,
-    ) -> Result<f64, EngineError> {
-        let step = self.step;
-        let material = &self.material;
-        let p = &mut self.particles;
-        let (mass, volume) = (&p.mass, &p.volume);
-        p.deformation
-            .par_iter_mut()
-            .zip(p.state.par_iter_mut())
-            .zip(velocity_gradients.par_iter())
-            .enumerate()
-            .map(|(i, ((f, state), gv))| {
-                let fail = |e| (i, e);
-                *f = (SMatrix::<f64, D, D>::identity() + gv * dt) * *f;
-                if !f.iter().all(|c| c.is_finite()) {
-                    return Err(fail(EngineError::NonFinite {
-                        step,
-                        field: "deformation gradient",
-                        entity: "particle",
-                        index: i,
-                    }));
-                }
-                let det = umls_constitutive::determinant(f);
-                if det <= 0.0 {
-                    return Err(fail(EngineError::Inverted {
-                        step,
-                        particle: i,
-                        det,
-                    }));
-                }
-                material.return_map(f, state).map_err(|source| {
-                    fail(EngineError::Material {
-                        step,
-                        particle: i,
-                        source,
-                    })
-                })?;
-                Ok(mass[i] / (volume[i] * det))
-            })
-            // Among failures the lowest particle index wins, so the report does not
-            // depend on the thread count.
-            .reduce(|| Ok(f64::INFINITY), |a, b| lowest_failure(a, b, f64::min))
-            .map_err(|(_, e)| e)
-    }
-
-    /// NaN and Courant checks after a step; records speed and density for the next Δt.
-    fn check_particles(
-        &mut self,
-        step: usize,
-        dt: f64,
-        min_density: f64,
-    ) -> Result<(), EngineError> {
-        let p = &self.particles;
-        if let Some(i) = (0..p.len())
-            .find(|&i| !(p.velocity[i].iter().chain(p.position[i].iter())).all(|c| c.is_finite()))
-        {
-            return Err(EngineError::NonFinite {
-                step,
-                field: "velocity or position",
-                entity: "particle",
-                index: i,
-            });
-        }
-        // The fastest particle, the first one among equals.
-        let (fastest, max_speed) = p
-            .velocity
-            .iter()
-            .map(|v| v.norm_squared())
-            .enumerate()
-            .fold((0, 0.0), |a, (i, s)| if s > a.1 { (i, s) } else { a });
-        let max_speed = max_speed.max(0.0).sqrt();
-        let h = self.kernel.spacing();
-        let (mover, moved) = self.totals.longest_move;
-        let (particle, courant) = if moved / h > max_speed * dt / h {
-            (mover, moved / h)
-        } else {
-            (fastest, max_speed * dt / h)
-        };
-        if courant > self.settings.max_courant {
-            return Err(EngineError::Unstable {
-                step,
-                particle,
-                courant,
-                limit: self.settings.max_courant,
-            });
-        }
-        self.totals.max_speed = max_speed;
-        self.totals.min_density = min_density;
-        Ok(())
-    }
-
-    /// The energy check: kinetic + elastic energy against what was put in.
-    fn check_energy(&mut self, step: usize) -> Result<(), EngineError> {
-        let p = &self.particles;
-        let kinetic: f64 = p
-            .mass
-            .iter()
-            .zip(&p.velocity)
-            .map(|(m, v)| 0.5 * m * v.norm_squared())
-            .sum();
-        let energy = kinetic + self.elastic_energy()?;
-        let initial = self.totals.initial_energy.unwrap_or(0.0);
-        let t = &mut self.totals;
-        t.energy_supplied = t.energy_supplied.max(initial + t.external_work);
-        if t.energy_supplied > 0.0 && energy > self.settings.energy_growth_limit * t.energy_supplied
-        {
-            return Err(EngineError::EnergyBlowUp {
-                step,
-                energy,
-                initial: t.energy_supplied,
-                factor: self.settings.energy_growth_limit,
-            });
-        }
-        Ok(())
-    }
-
-    /// MUSL: re-map the updated particle momenta to the grid and take the velocity
-    /// gradient of that grid velocity (stencils of the start of the step).
-    fn musl_velocity_gradients(&mut self) -> Vec<SMatrix<f64, D, D>> {
-        let g = &mut self.grid;
-        g.momentum.iter_mut().for_each(|m| *m = SVector::zeros());
-        let p = &self.particles;
-        for i in 0..p.len() {
-            let st = self.stencils.of(i);
-            for e in 0..st.len() {
-                let node = st.nodes[e] as usize;
-                g.momentum[node] += p.velocity[i] * (st.values[e] * p.mass[i]);
-            }
-        }
-        let fraction = self.settings.cancellation_fraction;
-        for node in 0..g.mass.len() {
-            g.velocity[node] = if g.is_active(node, fraction) {
-                g.momentum[node] / g.mass[node]
-            } else {
-                SVector::zeros()
-            };
-        }
-        self.boundary.apply(&mut g.velocity);
-        let (stencils, v) = (&self.stencils, &g.velocity);
-        (0..p.len())
-            .into_par_iter()
-            .map(|i| {
-                let st = stencils.of(i);
-                st.nodes
-                    .iter()
-                    .zip(st.gradients)
-                    .fold(SMatrix::<f64, D, D>::zeros(), |acc, (&node, gradient)| {
-                        acc + v[node as usize] * gradient.transpose()
-                    })
-            })
-            .collect()
     }
 }

@@ -12,6 +12,10 @@ pub trait TransferScheme: Copy + Send + Sync + std::fmt::Debug {
     /// Whether [`Self::affine`] reads B_p and D_p; G2P skips accumulating them otherwise.
     const USES_MOMENTS: bool = false;
 
+    /// Whether [`Self::velocity`] reads the FLIP increment; G2P skips reading the old
+    /// grid velocities otherwise.
+    const USES_FLIP: bool = false;
+
     /// Short name for reports.
     fn name(&self) -> &'static str;
 
@@ -88,6 +92,7 @@ impl TransferScheme for Pic {
 
 impl TransferScheme for Flip {
     const AFFINE: bool = false;
+    const USES_FLIP: bool = true;
     fn name(&self) -> &'static str {
         "FLIP"
     }

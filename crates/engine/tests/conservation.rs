@@ -209,13 +209,19 @@ fn ill_conditioned_mls_stops_the_run() {
     match &error {
         umls_engine::EngineError::Kernel {
             step: 0,
-            source:
-                umls_transfer::KernelError::Mls(umls_mls::MlsError::IllConditioned {
+            source: umls_transfer::KernelError::Evaluation { kernel, source },
+            ..
+        } => {
+            assert_eq!(*kernel, "UMLS");
+            // The kernel's own error type comes through, typed.
+            assert!(matches!(
+                source.downcast_ref::<umls_mls::MlsError>(),
+                Some(umls_mls::MlsError::IllConditioned {
                     simplex: Some(_),
                     ..
-                }),
-            ..
-        } => {}
+                })
+            ));
+        }
         other => panic!("unexpected {other}"),
     }
     assert!(

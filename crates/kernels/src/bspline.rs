@@ -22,11 +22,15 @@ impl BSplineOrder {
         }
     }
 
-    /// First stencil node (in units of h) for the coordinate ξ = (x − origin)/h.
-    fn base(self, xi: f64) -> f64 {
+    /// First stencil node for the coordinate ξ = (x − origin)/h: ⌊ξ − ½⌋ (quadratic) or
+    /// ⌊ξ⌋ − 1 (cubic), `None` where it would be negative (or ξ is NaN). Truncation is
+    /// the floor for the non-negative values kept, and compiles to one instruction on
+    /// every x86-64, where `f64::floor` is a library call without SSE4.1.
+    fn base(self, xi: f64) -> Option<usize> {
         match self {
-            Self::Quadratic => (xi - 0.5).floor(),
-            Self::Cubic => xi.floor() - 1.0,
+            Self::Quadratic => (xi >= 0.5).then_some((xi - 0.5) as usize),
+            // `then`, not `then_some`: below 1 the subtraction would underflow.
+            Self::Cubic => (xi >= 1.0).then(|| xi as usize - 1),
         }
     }
 
@@ -65,7 +69,7 @@ impl BSplineOrder {
 /// B-spline kernel on the grid `origin + h·(i₀, …, i_{D−1})`, `0 ≤ i_k ≤ cells[k]`.
 ///
 /// Node index `i₀ + (n₀+1)(i₁ + (n₁+1) i₂)`. A point's stencil must lie inside the grid:
-/// for quadratic splines that is ξ_k ∈ [0.5, n_k − 0.5], for cubic ξ_k ∈ [1, n_k − 1]
+/// for quadratic splines that is ξ_k ∈ [0.5, n_k − 0.5), for cubic ξ_k ∈ [1, n_k − 1)
 /// (ξ = (x − origin)/h); pad the grid by one or two cells around the material.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BSplineKernel<const D: usize> {
@@ -128,6 +132,38 @@ impl<const D: usize> BSplineKernel<D> {
         self.order
     }
 
+    /// The first stencil node per axis, or the error if the stencil leaves the grid.
+    fn base_nodes(&self, x: &SVector<f64, D>) -> Result<[usize; D], KernelError> {
+        let width = self.order.width();
+        let mut base = [0usize; D];
+        for k in 0..D {
+            match self.order.base((x[k] - self.origin[k]) / self.h) {
+                // Checked: a huge ξ saturates to usize::MAX.
+                Some(b)
+                    if b.checked_add(width - 1)
+                        .is_some_and(|top| top <= self.cells[k]) =>
+                {
+                    base[k] = b
+                }
+                _ => {
+                    return Err(KernelError::OutsideDomain {
+                        point: x.iter().copied().collect(),
+                    });
+                }
+            }
+        }
+        Ok(base)
+    }
+
+    /// How far the node index moves per step along each axis.
+    fn strides(&self) -> [usize; D] {
+        let mut strides = [1usize; D];
+        for k in 1..D {
+            strides[k] = strides[k - 1] * (self.cells[k - 1] + 1);
+        }
+        strides
+    }
+
     fn node_index(&self, ijk: [usize; D]) -> usize {
         let mut index = 0;
         for k in (0..D).rev() {
@@ -166,6 +202,23 @@ impl<const D: usize> Kernel<D> for BSplineKernel<D> {
         })
     }
 
+    fn recompute_stencils(&self) -> bool {
+        // 3^D (4^D) products of per-axis weights: cheaper than storing ~1 KB per particle
+        // in 3D and reading it back twice.
+        true
+    }
+
+    fn node_range(
+        &self,
+        x: &SVector<f64, D>,
+        _: &mut (),
+        _: &mut Stencil<D>,
+    ) -> Result<(u32, u32), KernelError> {
+        let base = self.base_nodes(x)?;
+        let top: [usize; D] = std::array::from_fn(|k| base[k] + self.order.width() - 1);
+        Ok((self.node_index(base) as u32, self.node_index(top) as u32))
+    }
+
     fn stencil(
         &self,
         x: &SVector<f64, D>,
@@ -173,53 +226,76 @@ impl<const D: usize> Kernel<D> for BSplineKernel<D> {
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError> {
         let width = self.order.width();
-        let mut base = [0usize; D];
-        // Per axis: weights and derivatives of the `width` nodes.
+        let base = self.base_nodes(x)?;
+        // Per axis: weights, derivatives and offsets x_i − x of the `width` nodes. The
+        // offset is computed as node_position(i) − x would be, so both agree bit for bit.
         let mut w = [[0.0; 4]; D];
         let mut dw = [[0.0; 4]; D];
+        let mut r = [[0.0; 4]; D];
         for k in 0..D {
             let xi = (x[k] - self.origin[k]) / self.h;
-            let b = self.order.base(xi);
-            if !(b >= 0.0 && b + (width - 1) as f64 <= self.cells[k] as f64) {
-                return Err(KernelError::OutsideDomain {
-                    point: x.iter().copied().collect(),
-                });
-            }
-            base[k] = b as usize;
             for a in 0..width {
-                let (value, derivative) = self.order.weight(xi - (b + a as f64));
+                let node = (base[k] + a) as f64;
+                let (value, derivative) = self.order.weight(xi - node);
                 w[k][a] = value;
                 dw[k][a] = derivative / self.h;
+                r[k][a] = self.origin[k] + self.h * node - x[k];
             }
         }
-        out.clear();
+        let strides = self.strides();
+        let first = self.node_index(base);
         let count = width.pow(D as u32);
-        for flat in 0..count {
-            let mut offsets = [0usize; D];
-            let mut rest = flat;
-            for o in offsets.iter_mut() {
-                *o = rest % width;
-                rest /= width;
+        let entries = out.entries_mut(count);
+        // Rows along axis 0 (the node numbering's fastest axis), written in place. The
+        // factors are multiplied in axis order, as N = Π_k w_k reads (regrouping them
+        // would change the last bit of the results).
+        let mut digits = [0usize; D];
+        let mut e = 0;
+        loop {
+            let mut node = first;
+            for k in 1..D {
+                node += digits[k] * strides[k];
             }
-            let mut value = 1.0;
-            for k in 0..D {
-                value *= w[k][offsets[k]];
-            }
-            let gradient = SVector::<f64, D>::from_fn(|j, _| {
-                (0..D)
-                    .map(|k| {
-                        if k == j {
-                            dw[k][offsets[k]]
+            for a in 0..width {
+                let mut value = w[0][a];
+                for k in 1..D {
+                    value *= w[k][digits[k]];
+                }
+                entries.values[e] = value;
+                entries.nodes[e] = (node + a) as u32;
+                entries.gradients[e] = SVector::<f64, D>::from_fn(|j, _| {
+                    let mut g = if j == 0 { dw[0][a] } else { w[0][a] };
+                    for k in 1..D {
+                        g *= if k == j {
+                            dw[k][digits[k]]
                         } else {
-                            w[k][offsets[k]]
-                        }
-                    })
-                    .product()
-            });
-            let node = self.node_index(std::array::from_fn(|k| base[k] + offsets[k]));
-            out.push(node as u32, value, gradient)?;
+                            w[k][digits[k]]
+                        };
+                    }
+                    g
+                });
+                entries.offsets[e] =
+                    SVector::<f64, D>::from_fn(
+                        |k, _| {
+                            if k == 0 { r[0][a] } else { r[k][digits[k]] }
+                        },
+                    );
+                e += 1;
+            }
+            // The next row: an odometer over axes 1..D.
+            let mut k = 1;
+            loop {
+                if k >= D {
+                    return Ok(());
+                }
+                digits[k] += 1;
+                if digits[k] < width {
+                    break;
+                }
+                digits[k] = 0;
+                k += 1;
+            }
         }
-        Ok(())
     }
 }
 
@@ -246,6 +322,46 @@ mod tests {
         assert!(BSplineKernel::covering(lower, upper, 0.0, BSplineOrder::Cubic).is_none());
         assert!(BSplineKernel::covering(lower, upper, f64::NAN, BSplineOrder::Cubic).is_none());
     }
+    /// Points off the grid by any amount, or not numbers, are outside the domain for both
+    /// the stencil and the node range (no overflow in the base node).
+    #[test]
+    fn far_and_non_finite_points_are_outside() {
+        for order in [BSplineOrder::Quadratic, BSplineOrder::Cubic] {
+            let grid = BSplineKernel::new(Vector2::zeros(), 0.1, [10, 10], order).unwrap();
+            let mut st = Stencil::new();
+            for bad in [
+                -0.01,
+                0.99,
+                1e300,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::NAN,
+            ] {
+                let x = Vector2::new(0.5, bad);
+                let outside = |r: Result<(), KernelError>| {
+                    matches!(r, Err(KernelError::OutsideDomain { .. }))
+                };
+                assert!(
+                    outside(grid.stencil(&x, &mut (), &mut st)),
+                    "{order:?} {bad}"
+                );
+                assert!(
+                    outside(grid.node_range(&x, &mut (), &mut st).map(|_| ())),
+                    "{order:?} {bad}"
+                );
+            }
+            // The last point inside: its stencil's top node is the grid's last.
+            let edge = match order {
+                BSplineOrder::Quadratic => 0.94,
+                BSplineOrder::Cubic => 0.89,
+            };
+            let range = grid
+                .node_range(&Vector2::new(edge, edge), &mut (), &mut st)
+                .unwrap();
+            assert_eq!(range.1 as usize, grid.node_count() - 1, "{order:?}");
+        }
+    }
+
     /// Node indices split into grid coordinates x fastest, for every node of a 3D grid
     /// with awkward counts and for indices beyond 2³² in 2D.
     #[test]

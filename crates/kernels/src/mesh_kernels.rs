@@ -6,7 +6,10 @@ use nalgebra::SVector;
 use std::marker::PhantomData;
 use umls_mesh::{Barycentric, SimplexMesh};
 
-use umls_mls::{CubicBSpline, GradientKind, Linear, PolynomialBasis, UmlsKernel, WeightFunction};
+use umls_mls::{
+    CubicBSpline, GradientKind, Linear, PolynomialBasis, Stencil as MlsStencil, UmlsKernel,
+    WeightFunction,
+};
 use umls_transfer::{DomainExit, Kernel, KernelError, Stencil};
 
 /// The node methods of a kernel whose nodes are the vertices of `self.mesh`.
@@ -184,8 +187,14 @@ where
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError> {
         let host = locate(&self.mesh, x, cache)?;
+        let mut mls = MlsStencil::new();
         self.kernel
-            .evaluate::<N, B>(&self.mesh, host, x, GradientKind::Reconstructed, out)?;
+            .evaluate::<N, B>(&self.mesh, host, x, GradientKind::Reconstructed, &mut mls)
+            .map_err(|e| KernelError::evaluation("UMLS", e))?;
+        out.clear();
+        for (v, n, g) in mls.iter() {
+            out.push(v, n, *g, self.mesh.vertex(v as usize) - x);
+        }
         Ok(())
     }
 }
@@ -231,7 +240,7 @@ impl<const D: usize> Kernel<D> for LinearFeKernel<D> {
             .zip(lambda.as_slice())
             .zip(gradients.as_slice())
         {
-            out.push(v, l, *g)?;
+            out.push(v, l, *g, self.mesh.vertex(v as usize) - x);
         }
         Ok(())
     }

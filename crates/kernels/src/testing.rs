@@ -6,6 +6,8 @@
 //! - linear reproduction of positions Σ N_i x_i = x and gradients Σ x_i ∇N_iᵀ = I;
 //! - the second moment the kernel declares (`Kernel::constant_second_moment`), if any;
 //! - node indices below `node_count`;
+//! - offsets x_i − x that match the node positions, and a `Kernel::node_range` equal
+//!   to the stencil's smallest and largest node;
 //! - the same stencil from a fresh location cache as from a warm one;
 //! - a typed `KernelError::OutsideDomain` far outside.
 //!
@@ -64,7 +66,7 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
         let mut position = SVector::<f64, D>::zeros();
         let mut jacobian = SMatrix::<f64, D, D>::zeros();
         let mut moment = SMatrix::<f64, D, D>::zeros();
-        for (node, n, g) in st.iter() {
+        for (e, (node, n, g)) in st.iter().enumerate() {
             if node as usize >= kernel.node_count() {
                 return Err(fail(format!(
                     "node {node} beyond the {} nodes",
@@ -72,6 +74,13 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
                 )));
             }
             let xi = kernel.node_position(node as usize);
+            let offset = st.offsets()[e];
+            if (offset - (xi - x)).norm() >= UNITY * h {
+                return Err(fail(format!(
+                    "offset of node {node} is {offset:?}, not x_i − x = {:?}",
+                    xi - x
+                )));
+            }
             sum += n;
             grad_sum += g;
             position += xi * n;
@@ -95,18 +104,32 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
                 return Err(fail(format!("Σ N r rᵀ = {moment}, not the declared {s} I")));
             }
         }
+        let range = kernel
+            .node_range(x, &mut K::Cache::default(), &mut fresh)
+            .map_err(|e| fail(format!("no node range inside the domain: {e}")))?;
+        if Some(range) != st.node_range() {
+            return Err(fail(format!(
+                "node_range gives {range:?}, the stencil spans {:?}",
+                st.node_range()
+            )));
+        }
         kernel
             .stencil(x, &mut K::Cache::default(), &mut fresh)
             .map_err(|e| fail(format!("no stencil from a fresh cache: {e}")))?;
-        if st.nodes() != fresh.nodes() || st.values() != fresh.values() {
+        if st != fresh {
             return Err(fail("a fresh cache gives another stencil".into()));
         }
     }
+    let outside_error = |what: &str, got: String| Violation {
+        point: outside.iter().copied().collect(),
+        message: format!("expected an outside-the-domain error from {what}, got {got}"),
+    };
     match kernel.stencil(&outside, &mut K::Cache::default(), &mut st) {
+        Err(KernelError::OutsideDomain { .. }) => {}
+        other => return Err(outside_error("stencil", format!("{other:?}"))),
+    }
+    match kernel.node_range(&outside, &mut K::Cache::default(), &mut st) {
         Err(KernelError::OutsideDomain { .. }) => Ok(()),
-        other => Err(Violation {
-            point: outside.iter().copied().collect(),
-            message: format!("expected an outside-the-domain error, got {other:?}"),
-        }),
+        other => Err(outside_error("node_range", format!("{other:?}"))),
     }
 }

@@ -116,7 +116,7 @@ fn bspline_gradients_and_sizes() {
 
 /// The suite catches what it checks: hat functions on [0, 1] pass it; scaled values, a
 /// wrong declared second moment, a node beyond the count, and no error outside each fail
-/// it with the property named.
+/// it with the property named, as do wrong offsets and a wrong node range.
 #[test]
 fn the_public_suite_catches_broken_kernels() {
     #[derive(Clone, Copy)]
@@ -125,6 +125,8 @@ fn the_public_suite_catches_broken_kernels() {
         moment: Option<f64>,
         node_count: usize,
         rejects_outside: bool,
+        offset_scale: f64,
+        claimed_range: Option<(u32, u32)>,
     }
     impl Kernel<1> for Hat {
         type Cache = ();
@@ -140,6 +142,15 @@ fn the_public_suite_catches_broken_kernels() {
         fn constant_second_moment(&self) -> Option<f64> {
             self.moment
         }
+        fn node_range(
+            &self,
+            x: &SVector<f64, 1>,
+            cache: &mut (),
+            scratch: &mut Stencil<1>,
+        ) -> Result<(u32, u32), umls_transfer::KernelError> {
+            self.stencil(x, cache, scratch)?;
+            Ok(self.claimed_range.unwrap_or((0, 1)))
+        }
         fn stencil(
             &self,
             x: &SVector<f64, 1>,
@@ -150,8 +161,18 @@ fn the_public_suite_catches_broken_kernels() {
                 return Err(umls_transfer::KernelError::OutsideDomain { point: vec![x[0]] });
             }
             out.clear();
-            out.push(0, self.scale * (1.0 - x[0]), SVector::from([-1.0]))?;
-            out.push(1, self.scale * x[0], SVector::from([1.0]))?;
+            out.push(
+                0,
+                self.scale * (1.0 - x[0]),
+                SVector::from([-1.0]),
+                SVector::from([-x[0]]),
+            );
+            out.push(
+                1,
+                self.scale * x[0],
+                SVector::from([1.0]),
+                SVector::from([self.offset_scale * (1.0 - x[0])]),
+            );
             Ok(())
         }
     }
@@ -160,6 +181,8 @@ fn the_public_suite_catches_broken_kernels() {
         moment: None,
         node_count: 2,
         rejects_outside: true,
+        offset_scale: 1.0,
+        claimed_range: None,
     };
     let points = [SVector::from([0.25]), SVector::from([0.6])];
     let outside = SVector::from([3.0]);
@@ -187,5 +210,19 @@ fn the_public_suite_catches_broken_kernels() {
             ..good
         })
         .contains("outside")
+    );
+    assert!(
+        failure(Hat {
+            offset_scale: 2.0,
+            ..good
+        })
+        .contains("offset of node 1")
+    );
+    assert!(
+        failure(Hat {
+            claimed_range: Some((0, 2)),
+            ..good
+        })
+        .contains("node_range")
     );
 }

@@ -21,8 +21,8 @@
 //!     fn stencil(&self, x: &SVector<f64, 1>, _: &mut (), out: &mut Stencil<1>) -> Result<(), KernelError> {
 //!         if !(0.0..=1.0).contains(&x[0]) { return Err(KernelError::OutsideDomain { point: vec![x[0]] }); }
 //!         out.clear();
-//!         out.push(0, 1.0 - x[0], SVector::from([-1.0]))?;
-//!         out.push(1, x[0], SVector::from([1.0]))?;
+//!         out.push(0, 1.0 - x[0], SVector::from([-1.0]), SVector::from([-x[0]]));
+//!         out.push(1, x[0], SVector::from([1.0]), SVector::from([1.0 - x[0]]));
 //!         Ok(())
 //!     }
 //! }
@@ -32,12 +32,17 @@
 //! # Ok::<(), KernelError>(())
 //! ```
 
+mod stencil;
+
+use std::sync::Arc;
+
 use nalgebra::SVector;
 use thiserror::Error;
-pub use umls_mls::{MAX_STENCIL, MlsError, Stencil};
+
+pub use stencil::{EntriesMut, Stencil};
 
 /// Why a kernel could not produce a stencil.
-#[derive(Debug, Clone, PartialEq, Error)]
+#[derive(Debug, Clone, Error)]
 pub enum KernelError {
     /// The point lies outside the kernel's domain (mesh or grid).
     #[error("point {point:?} is outside the kernel's domain")]
@@ -45,9 +50,50 @@ pub enum KernelError {
         /// Coordinates of the point.
         point: Vec<f64>,
     },
-    /// The MLS evaluation failed (ill-conditioned moment matrix, stencil overflow, …).
-    #[error(transparent)]
-    Mls(#[from] MlsError),
+    /// The kernel's own evaluation failed (an MLS moment matrix that is ill-conditioned,
+    /// …): the kernel names itself, and the cause is its own error type, which
+    /// `std::error::Error::source` and `downcast_ref` reach.
+    #[error("{kernel} kernel: {source}")]
+    Evaluation {
+        /// The kernel's name.
+        kernel: &'static str,
+        /// The kernel's error.
+        source: Arc<dyn std::error::Error + Send + Sync>,
+    },
+}
+
+impl KernelError {
+    /// A kernel's own error, as [`KernelError::Evaluation`].
+    pub fn evaluation(
+        kernel: &'static str,
+        error: impl std::error::Error + Send + Sync + 'static,
+    ) -> Self {
+        Self::Evaluation {
+            kernel,
+            source: Arc::new(error),
+        }
+    }
+}
+
+/// Equal when the variant, the point or the kernel name, and the cause's message match
+/// (the cause is a trait object, compared by what it says).
+impl PartialEq for KernelError {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (Self::OutsideDomain { point: a }, Self::OutsideDomain { point: b }) => a == b,
+            (
+                Self::Evaluation {
+                    kernel: a,
+                    source: e,
+                },
+                Self::Evaluation {
+                    kernel: b,
+                    source: f,
+                },
+            ) => a == b && e.to_string() == f.to_string(),
+            _ => false,
+        }
+    }
 }
 
 /// Where a point left a kernel's domain: the boundary facet it crossed (its nodes), the
@@ -87,13 +133,38 @@ pub trait Kernel<const D: usize>: Send + Sync {
     /// grid spacing for grid kernels, the shortest simplex height for mesh kernels).
     fn spacing(&self) -> f64;
 
-    /// Fills `out` with the stencil at `x`, using and updating `cache`.
+    /// Fills `out` with the stencil at `x`, using and updating `cache`. The same `x` and
+    /// cache must give the same stencil, bit for bit: the engine may evaluate a stencil
+    /// more than once in a step (see [`Self::recompute_stencils`]).
     fn stencil(
         &self,
         x: &SVector<f64, D>,
         cache: &mut Self::Cache,
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError>;
+
+    /// The smallest and largest node index of the stencil at `x` (the engine orders
+    /// particles by them), failing exactly where [`Self::stencil`] fails. The default
+    /// evaluates the stencil into `scratch`; a kernel that knows the range without the
+    /// values (a grid: the corners of the node block) overrides it.
+    fn node_range(
+        &self,
+        x: &SVector<f64, D>,
+        cache: &mut Self::Cache,
+        scratch: &mut Stencil<D>,
+    ) -> Result<(u32, u32), KernelError> {
+        self.stencil(x, cache, scratch)?;
+        Ok(scratch.node_range().unwrap_or((0, 0)))
+    }
+
+    /// Whether a stencil costs less to evaluate where it is used (P2G and G2P, so about
+    /// three times a step) than to store for the step and read back: true for cheap
+    /// closed forms (B-splines), whose stored stencils would be most of a particle's
+    /// memory traffic. The engine follows it unless a setting overrides it. Default:
+    /// false (store).
+    fn recompute_stencils(&self) -> bool {
+        false
+    }
 
     /// The second moment Σ_i N_i(x) (x_i − x)(x_i − x)ᵀ where it is the same multiple
     /// s·I of the identity at every x (s = h²/4 for quadratic, h²/3 for cubic B-splines),

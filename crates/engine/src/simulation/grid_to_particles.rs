@@ -1,0 +1,191 @@
+//! Stage 4 of the step, G2P: velocity, affine matrix, position and velocity gradient
+//! from the grid, then the walls.
+
+use nalgebra::{SMatrix, SVector};
+use rayon::prelude::*;
+use umls_constitutive::Constitutive;
+use umls_transfer::{Kernel, Stencil};
+
+use super::Simulation;
+use crate::boundary::Boundary;
+use crate::error::EngineError;
+use crate::parallel::lowest_failure;
+use crate::stencils::ParticleStencil;
+use crate::transfer::TransferScheme;
+
+/// What G2P computes for one particle.
+#[derive(Debug, Clone, Copy)]
+struct ParticleUpdate<const D: usize> {
+    velocity: SVector<f64, D>,
+    /// Moved with the PIC velocity Σ N ṽ_i.
+    position: SVector<f64, D>,
+    affine: SMatrix<f64, D, D>,
+    affine_moment: f64,
+    velocity_gradient: SMatrix<f64, D, D>,
+}
+
+/// The grid velocities before (`old`) and after (`new`) the grid update.
+struct GridVelocities<'a, const D: usize> {
+    old: &'a [SVector<f64, D>],
+    new: &'a [SVector<f64, D>],
+}
+
+/// One particle's G2P from its stencil `st` at position `x` with velocity `old`.
+fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
+    st: &ParticleStencil<'_, D>,
+    kernel: &K,
+    transfer: &T,
+    grid: &GridVelocities<'_, D>,
+    x: SVector<f64, D>,
+    old: &SVector<f64, D>,
+    dt: f64,
+) -> ParticleUpdate<D> {
+    let moment_scale = kernel.constant_second_moment();
+    let mut pic = SVector::<f64, D>::zeros();
+    let mut flip = SVector::<f64, D>::zeros();
+    let mut grad_v = SMatrix::<f64, D, D>::zeros();
+    let mut b = SMatrix::<f64, D, D>::zeros();
+    let mut d = moment_scale.map_or_else(SMatrix::zeros, |s| SMatrix::identity() * s);
+    for e in 0..st.len() {
+        let node = st.nodes[e] as usize;
+        let n = st.values[e];
+        let v = grid.new[node];
+        pic += v * n;
+        if T::USES_FLIP {
+            flip += (v - grid.old[node]) * n;
+        }
+        grad_v += v * st.gradients[e].transpose();
+        if T::AFFINE && (T::USES_MOMENTS || moment_scale.is_none()) {
+            let r = st.offset(e, kernel, &x);
+            if moment_scale.is_none() {
+                d += r * r.transpose() * n;
+            }
+            if T::USES_MOMENTS {
+                b += v * r.transpose() * n;
+            }
+        }
+    }
+    let affine = match moment_scale {
+        Some(s) => transfer.affine_with_constant_moment(&b, s, &grad_v),
+        None => transfer.affine(&b, &d, &grad_v),
+    };
+    ParticleUpdate {
+        velocity: transfer.velocity(old, &pic, &flip),
+        position: x + pic * dt,
+        affine_moment: if T::AFFINE {
+            (affine * d * affine.transpose()).trace()
+        } else {
+            0.0
+        },
+        affine,
+        velocity_gradient: grad_v,
+    }
+}
+
+/// One chunk's share of the G2P totals: work of the body loads, the longest move
+/// (particle, distance), and the wall corrections.
+type ChunkTotals = (f64, (usize, f64), usize);
+
+impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
+    /// G2P and the walls; the velocity gradients go to `self.velocity_gradients`.
+    pub(super) fn grid_to_particles(&mut self, dt: f64) -> Result<(), EngineError> {
+        let (kernel, transfer, stencils) = (&self.kernel, self.transfer, &self.stencils);
+        let grid = GridVelocities {
+            old: &self.grid.velocity,
+            new: &self.grid.new_velocity,
+        };
+        let mut velocity_gradients = std::mem::take(&mut self.velocity_gradients);
+        velocity_gradients.resize(self.particles.len(), SMatrix::zeros());
+        let p = &mut self.particles;
+        let (gravity, time, step) = (self.settings.gravity_at(self.time), self.time, self.step);
+        let body_force = self.body_force.as_ref();
+        let boundary = &self.boundary;
+        let marks = boundary
+            .has_node_conditions()
+            .then(|| boundary.node_marks(self.grid.mass.len()));
+        let chunk = crate::stencils::CHUNK;
+        // In parallel over fixed chunks; each particle's results go straight to the
+        // particle arrays, and the partial sums are joined in chunk order.
+        let partials: Result<Vec<ChunkTotals>, _> = p
+            .velocity
+            .par_chunks_mut(chunk)
+            .zip(p.position.par_chunks_mut(chunk))
+            .zip(p.affine.par_chunks_mut(chunk))
+            .zip(p.affine_moment.par_chunks_mut(chunk))
+            .zip(velocity_gradients.par_chunks_mut(chunk))
+            .enumerate()
+            .map(
+                |(c, ((((velocity, position), affine), moment), gradient))| {
+                    let mut scratch = Stencil::new();
+                    // Work of gravity and body forces with the mean of old and new velocity:
+                    // the trapezoidal rule balances the kinetic energy of a free fall exactly.
+                    let mut power = 0.0;
+                    // The longest move (the position follows the PIC velocity, which for FLIP
+                    // can differ from the stored one): the Courant check reads it.
+                    let mut longest = (0, 0.0f64);
+                    let mut corrections = 0;
+                    for k in 0..velocity.len() {
+                        let i = c * chunk + k;
+                        let x = position[k];
+                        let u = stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
+                            gather(&st, kernel, &transfer, &grid, x, &velocity[k], dt)
+                        })?;
+                        let acceleration = body_force.map_or(gravity, |b| gravity + b(&x, time));
+                        power += p.mass[i] * acceleration.dot(&(velocity[k] + u.velocity)) * 0.5;
+                        let moved = (u.position - x).norm();
+                        if moved > longest.1 {
+                            longest = (i, moved);
+                        }
+                        velocity[k] = u.velocity;
+                        position[k] = u.position;
+                        affine[k] = u.affine;
+                        moment[k] = u.affine_moment;
+                        gradient[k] = u.velocity_gradient;
+                        if boundary.hold(&mut position[k], &mut velocity[k]) {
+                            corrections += 1;
+                        }
+                        if let Some(marks) = &marks {
+                            if let Some(exit) = kernel.domain_exit(&position[k], &p.cache[i]) {
+                                if Boundary::hold_at_facet(
+                                    marks,
+                                    &exit,
+                                    &mut position[k],
+                                    &mut velocity[k],
+                                ) {
+                                    corrections += 1;
+                                }
+                            }
+                        }
+                    }
+                    Ok(vec![(power, longest, corrections)])
+                },
+            )
+            .reduce(
+                || Ok(Vec::new()),
+                |a, b| {
+                    lowest_failure(a, b, |mut x, y| {
+                        x.extend(y);
+                        x
+                    })
+                },
+            );
+        self.velocity_gradients = velocity_gradients;
+        let partials = partials.map_err(|(particle, source)| EngineError::Kernel {
+            step,
+            particle,
+            source,
+        })?;
+        let mut power = 0.0;
+        let mut longest = (0, 0.0f64);
+        for (chunk_power, chunk_longest, corrections) in partials {
+            power += chunk_power;
+            if chunk_longest.1 > longest.1 {
+                longest = chunk_longest;
+            }
+            self.totals.wall_corrections += corrections;
+        }
+        self.totals.external_work += power * dt;
+        self.totals.longest_move = longest;
+        Ok(())
+    }
+}

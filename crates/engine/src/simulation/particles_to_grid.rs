@@ -1,0 +1,108 @@
+//! Stage 2 of the step, P2G: every particle's mass, momentum and force to its stencil's
+//! nodes, through [`crate::scatter::Scatter`] (parallel, bitwise independent of the
+//! thread count).
+
+use nalgebra::{SMatrix, SVector};
+use umls_constitutive::Constitutive;
+use umls_transfer::{Kernel, Stencil};
+
+use super::Simulation;
+use crate::error::EngineError;
+use crate::stencils::ParticleStencil;
+use crate::transfer::TransferScheme;
+
+/// The affine matrix P2G spreads: C_p, scaled down if its kinetic energy at the
+/// particle's new position, tr(C D C^T) with D = Σ N r rᵀ there, exceeds what it had
+/// where G2P made it. For B-splines D is constant and nothing changes; for linear
+/// elements D goes from 0 at a vertex to its largest at the centroid, so a particle
+/// moving away from a vertex would carry the affine energy up with it — the energy
+/// source that blew up linear elements with APIC. Skipped where D is not positive
+/// (negative MLS values): there the bound means nothing.
+fn limited_affine<const D: usize, K: Kernel<D>>(
+    c: &SMatrix<f64, D, D>,
+    moment: f64,
+    st: &ParticleStencil<'_, D>,
+    kernel: &K,
+    x: &SVector<f64, D>,
+) -> SMatrix<f64, D, D> {
+    if !moment.is_finite() || moment <= 0.0 {
+        return if moment == 0.0 { SMatrix::zeros() } else { *c };
+    }
+    let mut d = SMatrix::<f64, D, D>::zeros();
+    for e in 0..st.len() {
+        let r = st.offset(e, kernel, x);
+        d += r * r.transpose() * st.values[e];
+    }
+    let now = (c * d * c.transpose()).trace();
+    if now > moment * (1.0 + 1e-9) {
+        c * (moment / now).sqrt()
+    } else {
+        *c
+    }
+}
+
+impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
+    /// P2G into the grid's mass, |N|-mass, stiffness, momentum and force.
+    pub(super) fn particles_to_grid(&mut self) -> Result<(), EngineError> {
+        let stresses = &self.stress_buffer;
+        let p = &self.particles;
+        let (stencils, kernel, time, step) = (&self.stencils, &self.kernel, self.time, self.step);
+        let gravity = self.settings.gravity_at(time);
+        let body_force = self.body_force.as_ref();
+        let g = &mut self.grid;
+        let sums = crate::scatter::NodalSums {
+            mass: &mut g.mass,
+            abs_mass: &mut g.abs_mass,
+            stiffness: &mut g.stiffness,
+            momentum: &mut g.momentum,
+            force: &mut g.force,
+        };
+        // With a constant second moment (B-splines) the affine energy cannot grow as a
+        // particle moves, and the limiter has nothing to do.
+        let varying_moment = kernel.constant_second_moment().is_none();
+        let ranges = stencils.ranges();
+        self.scatter
+            .scatter(ranges, sums, |block, window| {
+                let mut scratch = Stencil::new();
+                for &i in block {
+                    let i = i as usize;
+                    let (m, v, x) = (p.mass[i], p.velocity[i], p.position[i]);
+                    let volume = p.volume[i];
+                    let stress_volume = stresses[i] * volume;
+                    let acceleration =
+                        gravity + body_force.map_or(SVector::zeros(), |b| b(&x, time));
+                    stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
+                        let c = match (T::AFFINE, varying_moment) {
+                            (false, _) => SMatrix::zeros(),
+                            (true, true) => {
+                                limited_affine(&p.affine[i], p.affine_moment[i], &st, kernel, &x)
+                            }
+                            (true, false) => p.affine[i],
+                        };
+                        for e in 0..st.len() {
+                            let n = st.values[e];
+                            let gradient = st.gradients[e];
+                            let mut mv = v;
+                            if T::AFFINE {
+                                mv += c * st.offset(e, kernel, &x);
+                            }
+                            window.add(
+                                st.nodes[e] as usize,
+                                n * m,
+                                n.abs() * m,
+                                volume * gradient.norm_squared(),
+                                mv * (n * m),
+                                acceleration * (n * m) - stress_volume * gradient,
+                            );
+                        }
+                    })?;
+                }
+                Ok(())
+            })
+            .map_err(|(particle, source)| EngineError::Kernel {
+                step,
+                particle,
+                source,
+            })
+    }
+}
