@@ -63,8 +63,8 @@ impl<K: Kernel<2>> OneStress for Simulation<2, K, LinearElastic, Flip> {
     fn material_stress(&self, particle: usize) -> Result<nalgebra::Matrix2<f64>, Box<dyn Error>> {
         use umls::constitutive::Constitutive;
         Ok(self
-            .material
-            .kirchhoff_stress(&self.particles.deformation[particle], &())?)
+            .material()
+            .kirchhoff_stress(&self.particles().deformation[particle], &())?)
     }
 }
 

@@ -70,7 +70,7 @@ impl OutputDir {
         P: PlasticPart<D>,
         T: TransferScheme,
     {
-        let p = &sim.particles;
+        let p = &sim.particles();
         let mut grid = UnstructuredGrid::point_cloud(p.position.iter().map(pad_vector).collect());
         grid.add_point_vectors("velocity", &p.velocity)?;
         let displacement: Vec<SVector<f64, D>> = p
@@ -98,7 +98,7 @@ impl OutputDir {
         {
             let zz = if D == 2 {
                 let tau_zz = sim
-                    .material
+                    .material()
                     .out_of_plane_stress(f, state)
                     .map_err(|source| umls_engine::EngineError::Material {
                         step: sim.step_count(),
@@ -127,11 +127,11 @@ impl OutputDir {
             "material",
             p.state.iter().map(|s| i32::from(s.material)).collect(),
         )?;
-        let names = sim.material.state_scalar_names();
+        let names = sim.material().state_scalar_names();
         if !names.is_empty() {
             let mut values = Vec::with_capacity(p.len() * names.len());
             for s in &p.state {
-                sim.material.state_scalars(s, &mut values);
+                sim.material().state_scalars(s, &mut values);
             }
             for (k, name) in names.iter().enumerate() {
                 let column = values

@@ -519,12 +519,12 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
         self.boundary.reaction_sets.clone()
     }
     fn state_scalar_maxima(&self) -> Vec<(&'static str, f64)> {
-        let names = self.material.state_scalar_names();
+        let names = self.material().state_scalar_names();
         let mut maxima = vec![f64::NEG_INFINITY; names.len()];
         let mut values = Vec::with_capacity(names.len());
-        for s in &self.particles.state {
+        for s in &self.particles().state {
             values.clear();
-            self.material.state_scalars(s, &mut values);
+            self.material().state_scalars(s, &mut values);
             for (m, v) in maxima.iter_mut().zip(&values) {
                 *m = m.max(*v);
             }
@@ -538,10 +538,10 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
         &mut self.boundary
     }
     fn positions(&self) -> &[SVector<f64, D>] {
-        &self.particles.position
+        &self.particles().position
     }
     fn velocities(&self) -> &[SVector<f64, D>] {
-        &self.particles.velocity
+        &self.particles().velocity
     }
     fn write_particles(&self, out: &mut OutputDir, reference: &[SVector<f64, D>]) -> Result<()> {
         out.write_particles(self, reference)
@@ -568,7 +568,7 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
     }
     fn cauchy_stresses(&self) -> std::result::Result<Vec<SMatrix<f64, D, D>>, EngineError> {
         let mut stresses = self.stresses()?;
-        for (tau, f) in stresses.iter_mut().zip(&self.particles.deformation) {
+        for (tau, f) in stresses.iter_mut().zip(&self.particles().deformation) {
             *tau /= umls_constitutive::determinant(f);
         }
         Ok(stresses)

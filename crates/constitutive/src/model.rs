@@ -8,10 +8,12 @@ use crate::linalg::{Matrix, inverse_transpose, positive_jacobian};
 /// A material model in D dimensions.
 ///
 /// The engine keeps the total deformation gradient F per particle and one
-/// [`Self::State`]. Each step it updates F, calls [`Self::return_map`] (plastic models
-/// project onto the yield surface and update the state; elastic models do nothing), then
-/// asks for the Kirchhoff stress τ = Jσ, which the internal force f_i = −Σ_p V_p⁰ τ_p ∇N_i
-/// needs without a division by J.
+/// [`Self::State`]. Each step it updates F and calls [`Self::return_map_and_stress`]:
+/// the return map (plastic models project onto the yield surface and update the state;
+/// elastic models do nothing), then the Kirchhoff stress τ = Jσ of the returned state,
+/// which the next step's internal force f_i = −Σ_p V_p⁰ τ_p ∇N_i needs without a
+/// division by J. [`Self::kirchhoff_stress`] alone is asked before the first step and
+/// after particles or material were edited.
 pub trait Constitutive<const D: usize>: Send + Sync + Debug {
     /// Per-particle internal state (`()` for elastic models).
     type State: Clone + Debug + PartialEq + Send + Sync;
@@ -27,6 +29,19 @@ pub trait Constitutive<const D: usize>: Send + Sync + Debug {
     fn return_map(&self, f: &Matrix<D>, state: &mut Self::State) -> Result<(), ConstitutiveError> {
         let _ = (f, state);
         Ok(())
+    }
+
+    /// [`Self::return_map`], then the Kirchhoff stress of the returned state: what the
+    /// engine asks at the end of every step (the stress is the next step's). Plastic
+    /// models override it to take both from one decomposition of the trial elastic
+    /// deformation instead of two; the result equals the two calls up to round-off.
+    fn return_map_and_stress(
+        &self,
+        f: &Matrix<D>,
+        state: &mut Self::State,
+    ) -> Result<Matrix<D>, ConstitutiveError> {
+        self.return_map(f, state)?;
+        self.kirchhoff_stress(f, state)
     }
 
     /// Kirchhoff stress τ = J σ (symmetric).

@@ -177,13 +177,29 @@ impl<const D: usize, Y: YieldCriterion> Constitutive<D> for ElastoPlastic<Y> {
         f: &Matrix<D>,
         state: &mut PlasticState<D>,
     ) -> Result<(), ConstitutiveError> {
+        self.return_map_and_stress(f, state).map(|_| ())
+    }
+
+    /// One SVD of the trial elastic deformation gives both the return map and the
+    /// stress: τ = U diag(τ_i) Uᵀ with the trial principal stresses if they are
+    /// admissible, the projected ones otherwise (the returned Fᵉ = U diag(e^ε) Vᵀ shares
+    /// U, so this is the stress `kirchhoff_stress` would compute from the new state).
+    fn return_map_and_stress(
+        &self,
+        f: &Matrix<D>,
+        state: &mut PlasticState<D>,
+    ) -> Result<Matrix<D>, ConstitutiveError> {
         let (lambda, mu) = (self.parameters.lambda(), self.parameters.mu());
         let trial = self.elastic_strain(f, state)?;
         let tau = hencky_stress(&trial.eps, lambda, mu);
+        let rotate = |principal: &Principal| {
+            let diag = SVector::<f64, D>::from_fn(|i, _| principal[i]);
+            trial.u * Matrix::<D>::from_diagonal(&diag) * trial.u.transpose()
+        };
         let accumulated = state.accumulated_plastic_strain;
         let f_trial = self.criterion.yield_function(&tau, accumulated);
         if f_trial <= YIELD_TOLERANCE * self.criterion.stress_scale(accumulated) {
-            return Ok(());
+            return Ok(rotate(&tau));
         }
         let projected = self.criterion.project(&tau, accumulated, lambda, mu);
         let eps = hencky_strain(&projected, lambda, mu);
@@ -205,7 +221,7 @@ impl<const D: usize, Y: YieldCriterion> Constitutive<D> for ElastoPlastic<Y> {
             state.out_of_plane_strain = eps[2];
         }
         state.accumulated_plastic_strain += (2.0f64 / 3.0).sqrt() * plastic_increment;
-        Ok(())
+        Ok(rotate(&projected))
     }
 
     fn kirchhoff_stress(

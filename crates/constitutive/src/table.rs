@@ -176,6 +176,19 @@ impl<const D: usize, P: PlasticPart<D>> Constitutive<D> for MaterialTable<P> {
         per_material!(self, kirchhoff_stress, f, state)
     }
 
+    fn return_map_and_stress(
+        &self,
+        f: &SMatrix<f64, D, D>,
+        state: &mut Self::State,
+    ) -> Result<SMatrix<f64, D, D>, ConstitutiveError> {
+        match self.get(state.material)? {
+            Model::Elastic(m) => {
+                elastic_dispatch!(m, m => Constitutive::<D>::kirchhoff_stress(m, f, &()))
+            }
+            Model::Plastic(p) => p.model().return_map_and_stress(f, &mut state.plastic),
+        }
+    }
+
     fn out_of_plane_stress(
         &self,
         f: &SMatrix<f64, D, D>,

@@ -1,5 +1,6 @@
 //! Return mapping: admissibility, elastic states untouched, idempotence, non-negative
-//! dissipation, closed-form pure-shear and apex answers, path independence of radial
+//! dissipation, the fused return map and stress equal to the two separate calls,
+//! closed-form pure-shear and apex answers, path independence of radial
 //! loading, and 2D plane strain against 3D with ε_zz = 0.
 
 use nalgebra::{Matrix2, Matrix3, SMatrix, Vector3};
@@ -67,6 +68,19 @@ fn check_return_map<Y: YieldCriterion>(
     let before = Constitutive::<3>::initial_state(m);
     let mut after = before.clone();
     m.return_map(f, &mut after).unwrap();
+    // The fused call (one SVD) updates the state alike and returns the stress that the
+    // separate call computes from the new state.
+    let mut fused = before.clone();
+    let tau = m.return_map_and_stress(f, &mut fused).unwrap();
+    prop_assert_eq!(&fused, &after);
+    let separate = m.kirchhoff_stress(f, &after).unwrap();
+    prop_assert!(
+        (tau - separate).norm() <= 1e-9 * m.parameters.mu(),
+        "{}: fused stress {} against {}",
+        Y::NAME,
+        tau,
+        separate
+    );
     prop_assert!(
         yield_after(m, f, &after) <= 1e-8,
         "{}: outside the surface by {}",
@@ -140,11 +154,17 @@ fn compare_2d_3d<Y: YieldCriterion>(
         f2 = (Matrix2::identity() + Matrix2::from_row_slice(g)) * f2;
         let mut f3 = Matrix3::identity();
         f3.fixed_view_mut::<2, 2>(0, 0).copy_from(&f2);
-        m.return_map(&f2, &mut s2).unwrap();
+        // 2D through the fused call, 3D through the separate ones.
+        let t2_fused = m.return_map_and_stress(&f2, &mut s2).unwrap();
         m.return_map(&f3, &mut s3).unwrap();
         let t2 = m.kirchhoff_stress(&f2, &s2).unwrap();
         let t3 = m.kirchhoff_stress(&f3, &s3).unwrap();
         let scale = 1.0 + t3.norm();
+        prop_assert!(
+            (t2_fused - t2).norm() < 1e-9 * scale,
+            "{}: fused 2D stress",
+            Y::NAME
+        );
         prop_assert!(
             (t3.fixed_view::<2, 2>(0, 0) - t2).norm() < 1e-9 * scale,
             "{}: in-plane {} vs {}",

@@ -31,12 +31,12 @@ pub type BodyForce<const D: usize> =
 pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> {
     /// The shape-function kernel (grid or mesh).
     pub kernel: K,
-    /// The material.
-    pub material: M,
+    /// The material ([`Self::material`], [`Self::material_mut`]).
+    material: M,
     /// The transfer scheme.
     pub transfer: T,
-    /// The particles.
-    pub particles: Particles<D, M::State, K::Cache>,
+    /// The particles ([`Self::particles`], [`Self::particles_mut`]).
+    particles: Particles<D, M::State, K::Cache>,
     /// Boundary conditions.
     pub boundary: Boundary<D>,
     /// Step settings.
@@ -54,6 +54,10 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     // Per-particle buffers the step reuses, so a step allocates nothing once they have
     // grown to the particle count.
     stress_buffer: Vec<SMatrix<f64, D, D>>,
+    /// Whether `stress_buffer` holds the stresses of the particles' current F and state
+    /// under the current material (left by the last deformation update; cleared by
+    /// every mutable access to particles or material).
+    stresses_current: bool,
     /// Scratch and results of the reaction sets' forces.
     reactions: (
         crate::grid::ReactionScratch<D>,
@@ -176,10 +180,36 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             scatter: Default::default(),
             times: StageTimes::default(),
             stress_buffer: Vec::new(),
+            stresses_current: false,
             reactions: Default::default(),
             velocity_gradients: Vec::new(),
             grid,
         })
+    }
+
+    /// The particles.
+    pub fn particles(&self) -> &Particles<D, M::State, K::Cache> {
+        &self.particles
+    }
+
+    /// The particles, to edit between steps (positions, velocities, F, state, …). The
+    /// stresses the last step computed for the next one are recomputed from what the
+    /// particles hold after the edit.
+    pub fn particles_mut(&mut self) -> &mut Particles<D, M::State, K::Cache> {
+        self.stresses_current = false;
+        &mut self.particles
+    }
+
+    /// The material.
+    pub fn material(&self) -> &M {
+        &self.material
+    }
+
+    /// The material, to change between steps; as for [`Self::particles_mut`], the next
+    /// step recomputes the stresses with it.
+    pub fn material_mut(&mut self) -> &mut M {
+        self.stresses_current = false;
+        &mut self.material
     }
 
     /// Steps taken.
@@ -392,6 +422,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 )
             })
             .collect();
+        self.stresses_current = false;
         for (f, u) in self.particles.deformation.iter_mut().zip(stretches) {
             *f = u?;
         }

@@ -57,7 +57,7 @@ fn slide<K: Kernel<2, Cache = HostCache>>(kernel: K, mesh: &SimplexMesh<2>) -> (
     let tangent = Rotation2::new(THETA) * Vector2::new(1.0, 0.0);
     let normal = Vector2::new(-tangent.y, tangent.x);
     let centroid = |s: &Simulation<2, K, NeoHookean, Pic>| {
-        s.particles.position.iter().sum::<Vector2<f64>>() / s.particles.len() as f64
+        s.particles().position.iter().sum::<Vector2<f64>>() / s.particles().len() as f64
     };
     let start = centroid(&sim);
     for _ in 0..200 {
@@ -143,7 +143,7 @@ fn body_force_fields() {
         a.step().unwrap();
         b.step().unwrap();
     }
-    assert_eq!(a.particles.position, b.particles.position);
+    assert_eq!(a.particles().position, b.particles().position);
     // A harmonic trap b(x) = −k (x − c).
     let centre = Vector2::new(1.0, 0.5);
     let k = 40.0;
@@ -159,10 +159,10 @@ fn body_force_fields() {
     for _ in 0..5 {
         let before = trap.diagnostics().unwrap().momentum;
         let impulse: Vector2<f64> = trap
-            .particles
+            .particles()
             .position
             .iter()
-            .zip(&trap.particles.mass)
+            .zip(&trap.particles().mass)
             .map(|(x, m)| (x - centre) * (-k * m * 1e-3))
             .sum();
         trap.step().unwrap();

@@ -74,7 +74,7 @@ fn state<const D: usize, K: Kernel<D> + Clone + Send + Sync>(
         for _ in 0..steps {
             sim.step().unwrap();
         }
-        let p = &sim.particles;
+        let p = &sim.particles();
         (
             p.position.clone(),
             p.velocity.clone(),

@@ -227,7 +227,7 @@ fn collide_with<K: Kernel<2>, M: Constitutive<2, State = ()>, T: TransferScheme>
     let before = sim.diagnostics().unwrap();
     run(&mut sim, 3000)?;
     let after = sim.diagnostics().unwrap();
-    let scale: f64 = sim.particles.mass.iter().sum::<f64>() * 0.1;
+    let scale: f64 = sim.particles().mass.iter().sum::<f64>() * 0.1;
     assert!(
         (after.momentum - before.momentum).norm() < 1e-12 * scale,
         "{} {} at {cells} cells: momentum {:?}, dropped mass {}",
@@ -274,7 +274,7 @@ fn column<K: Kernel<2>>(kernel: K, geostatic: bool, band: (f64, f64)) -> f64 {
     settings.damping = Damping::Local { alpha: 0.7 };
     let mut sim = Simulation::new(kernel, material, Pic, particles, settings).unwrap();
     sim.settings.dt = sim.stable_time_step(0.3);
-    let positions = sim.particles.position.clone();
+    let positions = sim.particles().position.clone();
     for (point, normal) in [
         ((0.0, 0.0), (1.0, 0.0)),
         ((1.0, 0.0), (1.0, 0.0)),
@@ -301,7 +301,7 @@ fn column<K: Kernel<2>>(kernel: K, geostatic: bool, band: (f64, f64)) -> f64 {
     assert!(d.max_speed < 0.02, "column not at rest: {d:?}");
     // Particles may not leave through the walls.
     assert!(
-        sim.particles
+        sim.particles()
             .position
             .iter()
             .all(|x| x.x >= 0.0 && x.x <= 1.0 && x.y >= 0.0)
@@ -393,7 +393,7 @@ fn walls_hold_for_every_kernel() {
         settings.time_step = TimeStepControl::Adaptive { cfl: 0.3 };
         let mut sim = Simulation::new(kernel, elastic(2e5), Pic, particles, settings).unwrap();
         sim.settings.dt = 1e-3;
-        let positions = sim.particles.position.clone();
+        let positions = sim.particles().position.clone();
         let mut floor = SVector::<f64, D>::zeros();
         floor[D - 1] = 1.0;
         let mut side = SVector::<f64, D>::zeros();
@@ -406,7 +406,7 @@ fn walls_hold_for_every_kernel() {
         let mut lowest = f64::INFINITY;
         while sim.time() < 0.4 {
             sim.step().unwrap_or_else(|e| panic!("{name} {D}D: {e}"));
-            for x in &sim.particles.position {
+            for x in &sim.particles().position {
                 assert!(
                     x[0] >= 0.0 && x[D - 1] >= 0.0,
                     "{name} {D}D: {x:?} beyond a wall"
@@ -524,7 +524,7 @@ fn drucker_prager_collapse_runs_with_every_kernel() {
         let mut sim =
             Simulation::new(kernel, material, Flip { alpha: 0.99 }, particles, settings).unwrap();
         sim.settings.dt = 1e-3;
-        let positions = sim.particles.position.clone();
+        let positions = sim.particles().position.clone();
         let mut up = SVector::<f64, D>::zeros();
         up[D - 1] = 1.0;
         let mut side = SVector::<f64, D>::zeros();
@@ -547,7 +547,7 @@ fn drucker_prager_collapse_runs_with_every_kernel() {
         while sim.time() < 0.3 {
             sim.step().unwrap_or_else(|e| panic!("{name} {D}D: {e}"));
         }
-        let x = &sim.particles.position;
+        let x = &sim.particles().position;
         assert!(
             x.iter().all(|x| x[0] >= 0.0 && x[D - 1] >= 0.0),
             "{name} {D}D"
@@ -637,7 +637,7 @@ fn node_set_walls_hold() {
         while sim.time() < 0.12 {
             sim.step().unwrap_or_else(|e| panic!("{name} {D}D: {e}"));
         }
-        for x in &sim.particles.position {
+        for x in &sim.particles().position {
             assert!(mesh.locate(x).is_some(), "{name} {D}D: {x:?} left the mesh");
         }
     }
@@ -778,7 +778,7 @@ fn first_wall_correction(kernel: Umls2) -> Option<usize> {
     for step in 0..1700 {
         sim.step().unwrap();
         let lowest = sim
-            .particles
+            .particles()
             .position
             .iter()
             .map(|x| x.y)

@@ -172,7 +172,7 @@ impl VibratingBar {
             sim.step()?;
             energy_error = energy_error.max((sim.diagnostics()?.total_energy() - e0).abs() / e0);
             let t = sim.time();
-            for (v, x) in sim.particles.velocity.iter().zip(&reference) {
+            for (v, x) in sim.particles().velocity.iter().zip(&reference) {
                 sq += (v[0] - self.velocity(*x, t)).powi(2);
                 count += 1.0;
             }

@@ -59,8 +59,8 @@ fn umls_disks_collide_and_rebound() {
         max_energy < 1.0001 * history[0].total_energy(),
         "energy grew to {max_energy}"
     );
-    let half = sim.particles.len() / 2;
-    let velocity = sim.particles.velocity[..half]
+    let half = sim.particles().len() / 2;
+    let velocity = sim.particles().velocity[..half]
         .iter()
         .sum::<nalgebra::Vector2<f64>>()
         / half as f64;
