@@ -302,7 +302,10 @@ fn bspline<const D: usize>(ctx: &Context<'_, D>, order: BSplineOrder) -> Result<
     let (lower, upper) = background.bounding_box();
     let kernel = BSplineKernel::covering(lower, upper, h, order).ok_or_else(|| {
         ctx.scene
-            .value_error("kernel.grid_spacing", "too coarse for one B-spline stencil")
+            .value_error(
+                "kernel.grid_spacing",
+                "too coarse for one B-spline stencil, or so fine that the grid has more than 2^32 nodes",
+            )
     })?;
     let nodes: f64 = kernel.cells().iter().map(|&n| n as f64 + 1.0).product();
     if nodes > MAX_GRID_NODES {

@@ -80,15 +80,23 @@ pub struct BSplineKernel<const D: usize> {
 }
 
 impl<const D: usize> BSplineKernel<D> {
-    /// A grid of `cells` cells of size `h` from `origin`; `None` for h ≤ 0 or too few cells
-    /// for one stencil.
+    /// A grid of `cells` cells of size `h` from `origin`; `None` for h ≤ 0, too few cells
+    /// for one stencil, or more nodes than u32 indices address (2³²).
     pub fn new(
         origin: SVector<f64, D>,
         h: f64,
         cells: [usize; D],
         order: BSplineOrder,
     ) -> Option<Self> {
-        let ok = h.is_finite() && h > 0.0 && cells.iter().all(|&n| n + 1 >= order.width());
+        // Stencils carry node indices as u32: every node must have one.
+        let nodes = cells
+            .iter()
+            .try_fold(1usize, |count, &n| count.checked_mul(n.checked_add(1)?));
+        let addressable = nodes.is_some_and(|count| count - 1 <= u32::MAX as usize);
+        let ok = h.is_finite()
+            && h > 0.0
+            && addressable
+            && cells.iter().all(|&n| n + 1 >= order.width());
         ok.then_some(Self {
             origin,
             h,
@@ -321,6 +329,19 @@ mod tests {
         assert_eq!(grid.cells(), [12 + 4, 5 + 4]);
         assert!(BSplineKernel::covering(lower, upper, 0.0, BSplineOrder::Cubic).is_none());
         assert!(BSplineKernel::covering(lower, upper, f64::NAN, BSplineOrder::Cubic).is_none());
+        // 2³² nodes have u32 indices; one more layer does not.
+        let at_limit = [65_535, 65_535];
+        assert!(
+            BSplineKernel::new(Vector2::zeros(), 1.0, at_limit, BSplineOrder::Quadratic).is_some()
+        );
+        let beyond = [65_535, 65_536];
+        assert!(
+            BSplineKernel::new(Vector2::zeros(), 1.0, beyond, BSplineOrder::Quadratic).is_none()
+        );
+        let absurd = [usize::MAX, 3];
+        assert!(
+            BSplineKernel::new(Vector2::zeros(), 1.0, absurd, BSplineOrder::Quadratic).is_none()
+        );
     }
     /// Points off the grid by any amount, or not numbers, are outside the domain for both
     /// the stencil and the node range (no overflow in the base node).
