@@ -18,7 +18,7 @@ use umls_engine::{
 };
 use umls_io::csv::HistoryWriter;
 use umls_io::vtk::Encoding;
-use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, UmlsMeshKernel};
+use umls_kernels::{BSplineKernel, BSplineOrder, GradientKind, LinearFeKernel, UmlsMeshKernel};
 use umls_mesh::SimplexMesh;
 use umls_mls::{DEFAULT_SUPPORT_FACTOR, Linear, Profile, Quadratic, SupportRadius, UmlsKernel};
 use umls_transfer::Kernel;
@@ -31,7 +31,9 @@ use crate::probes::Probes;
 use crate::progress::Progress;
 use crate::reference;
 use crate::scene::Scene;
-use crate::schema::{EncodingSpec, KernelKind, SupportSpec, TransferKind, WeightSpec};
+use crate::schema::{
+    EncodingSpec, GradientSpec, KernelKind, SupportSpec, TransferKind, WeightSpec,
+};
 use crate::setup::{self, Setup, Split};
 use crate::{conditions, end_metrics};
 use umls_constitutive::Constitutive;
@@ -118,15 +120,22 @@ impl Dimension<3> for D3 {
     }
 }
 
-/// A UMLS kernel type built from a mesh and MLS settings: what `Dimension` names per
-/// dimension is only the basis size, the construction is the same for all.
+/// A UMLS kernel type built from a mesh, MLS settings and the gradient kind: what
+/// `Dimension` names per dimension is only the basis size, the construction is the same
+/// for all.
 trait FromMls<const D: usize> {
-    fn from_mls(mesh: Arc<SimplexMesh<D>>, mls: UmlsKernel<D, Profile>) -> Self;
+    fn from_mls(
+        mesh: Arc<SimplexMesh<D>>,
+        settings: (UmlsKernel<D, Profile>, GradientKind),
+    ) -> Self;
 }
 
 impl<const D: usize, const N: usize, B> FromMls<D> for UmlsMeshKernel<D, N, B, Profile> {
-    fn from_mls(mesh: Arc<SimplexMesh<D>>, mls: UmlsKernel<D, Profile>) -> Self {
-        Self::with_kernel(mesh, mls)
+    fn from_mls(
+        mesh: Arc<SimplexMesh<D>>,
+        (mls, gradient): (UmlsKernel<D, Profile>, GradientKind),
+    ) -> Self {
+        Self::with_kernel(mesh, mls).with_gradient(gradient)
     }
 }
 
@@ -206,7 +215,8 @@ fn run_dim<const D: usize, X: Dimension<D>>(
         KernelKind::Umls
         | KernelKind::UmlsWendland
         | KernelKind::UmlsWide
-        | KernelKind::UmlsPaper => {
+        | KernelKind::UmlsPaper
+        | KernelKind::UmlsFullGradient => {
             let mesh = mesh()?;
             let mls = umls_settings(&ctx, &mesh)?;
             with_kernel::<D, X, _>(&ctx, X::Umls::from_mls(mesh, mls))
@@ -224,14 +234,14 @@ fn run_dim<const D: usize, X: Dimension<D>>(
     }
 }
 
-/// The MLS settings of a UMLS kernel: the kernel name's preset (profile, radius rule
-/// and factor), with `[kernel]`'s `weight`, `support` and `support_factor` overriding
-/// it. The quadratic basis needs six (2D) or ten (3D) weighted samples, more than a
+/// The MLS settings of a UMLS kernel and its gradient kind: the kernel name's preset
+/// (profile, radius rule, factor, gradient), with `[kernel]`'s `weight`, `support`,
+/// `support_factor` and `gradient` overriding it. The quadratic basis needs six (2D) or ten (3D) weighted samples, more than a
 /// vertex on a wall or in a corner has, so its quadratic terms carry a small ridge.
 fn umls_settings<const D: usize>(
     ctx: &Context<'_, D>,
     mesh: &SimplexMesh<D>,
-) -> Result<UmlsKernel<D, Profile>> {
+) -> Result<(UmlsKernel<D, Profile>, GradientKind)> {
     let spec = &ctx.scene.spec.kernel;
     let (weight, support, factor) = umls_preset(ctx.kernel);
     let weight = match spec.weight.unwrap_or(weight) {
@@ -251,7 +261,12 @@ fn umls_settings<const D: usize>(
     if ctx.kernel == KernelKind::UmlsQuadratic {
         mls.conditioning.higher_order_ridge = QUADRATIC_RIDGE;
     }
-    Ok(mls)
+    let preset_gradient = if ctx.kernel == KernelKind::UmlsFullGradient {
+        GradientSpec::Full
+    } else {
+        GradientSpec::Reconstructed
+    };
+    Ok((mls, spec.gradient.unwrap_or(preset_gradient).kind()))
 }
 
 /// Relative ridge on the quadratic monomials of `umls-quadratic`.

@@ -172,6 +172,10 @@ pub enum KernelKind {
     UmlsWide,
     /// UMLS with the paper's one global radius, the mesh's longest edge.
     UmlsPaper,
+    /// The `umls` kernel with the full derivative of the MLS fit as shape-function
+    /// gradient (divergence-consistent on unstructured tetrahedra, discontinuous across
+    /// facets) instead of the reconstructed one.
+    UmlsFullGradient,
     /// Linear finite-element shape functions on the mesh.
     LinearFe,
     /// Quadratic B-splines on a Cartesian grid covering the mesh.
@@ -189,6 +193,7 @@ impl KernelKind {
             KernelKind::UmlsWendland => "umls-wendland",
             KernelKind::UmlsWide => "umls-wide",
             KernelKind::UmlsPaper => "umls-paper",
+            KernelKind::UmlsFullGradient => "umls-full-gradient",
             KernelKind::LinearFe => "linear-fe",
             KernelKind::Bspline2 => "bspline2",
             KernelKind::Bspline3 => "bspline3",
@@ -212,6 +217,8 @@ pub struct KernelSpec {
     pub support: Option<SupportSpec>,
     /// UMLS kernels: multiplier of the support radius (default: the kernel name's).
     pub support_factor: Option<f64>,
+    /// UMLS kernels: which shape-function gradient (default: the kernel name's).
+    pub gradient: Option<GradientSpec>,
     /// Whether stencils are stored for the step or recomputed where used (default: the
     /// kernel's choice, `auto`).
     #[serde(default)]
@@ -266,6 +273,7 @@ impl KernelKind {
                 | KernelKind::UmlsWendland
                 | KernelKind::UmlsWide
                 | KernelKind::UmlsPaper
+                | KernelKind::UmlsFullGradient
         )
     }
 }
@@ -278,6 +286,26 @@ pub enum WeightSpec {
     CubicBspline,
     /// Wendland's C² function.
     Wendland,
+}
+
+/// `kernel.gradient`: the UMLS shape-function gradient.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GradientSpec {
+    /// The MLS fit's reconstructed gradient, continuous across facets.
+    Reconstructed,
+    /// The full derivative of the fit, weights included.
+    Full,
+}
+
+impl GradientSpec {
+    /// The MLS crate's setting.
+    pub fn kind(self) -> umls_kernels::GradientKind {
+        match self {
+            Self::Reconstructed => umls_kernels::GradientKind::Reconstructed,
+            Self::Full => umls_kernels::GradientKind::Full,
+        }
+    }
 }
 
 /// `kernel.support`: the UMLS support radius rule.

@@ -214,6 +214,7 @@ fn kernel_override_and_conservation() {
         "umls-wide",
         "umls-paper",
         "umls-wendland",
+        "umls-full-gradient",
     ] {
         let dir = scratch(&format!("disks-{kernel}"));
         let out = umls(&[

@@ -44,3 +44,5 @@ pub use bspline::{BSplineKernel, BSplineOrder};
 pub use mesh_kernels::{
     HostCache, LinearFeKernel, Umls1, Umls2, Umls3, UmlsMeshKernel, UmlsQuadratic2, UmlsQuadratic3,
 };
+#[cfg(feature = "mesh")]
+pub use umls_mls::GradientKind;

@@ -113,8 +113,14 @@ fn locate<const D: usize>(
     Ok(found.simplex)
 }
 
-/// The UMLS kernel (C¹ diminishing-weight MLS over the host's 1-ring, reconstructed
-/// gradient) as an MPM kernel. Nodes are the mesh vertices.
+/// The UMLS kernel (C¹ diminishing-weight MLS over the host's 1-ring) as an MPM kernel.
+/// Nodes are the mesh vertices.
+///
+/// The shape-function gradient is the MLS fit's reconstructed ("diffuse") gradient by
+/// default, which is continuous across facets; [`Self::with_gradient`] selects the full
+/// derivative instead, which differentiates the weights too: it is divergence-consistent
+/// on unstructured tetrahedra where the reconstructed one is not, but it jumps across
+/// facets with the diminishing factor's gradient (docs/umls-kernel.md has both measured).
 ///
 /// `N` is the size of the polynomial basis `B` (D + 1 for [`Linear`], the default;
 /// (D + 1)(D + 2)/2 for [`umls_mls::Quadratic`]) and `W` the distance-weight profile.
@@ -127,6 +133,7 @@ where
 {
     mesh: Arc<SimplexMesh<D>>,
     kernel: UmlsKernel<D, W>,
+    gradient: GradientKind,
     basis: PhantomData<fn() -> B>,
 }
 
@@ -156,8 +163,21 @@ impl<const D: usize, const N: usize, B, W: WeightFunction> UmlsMeshKernel<D, N, 
         Self {
             mesh,
             kernel,
+            gradient: GradientKind::Reconstructed,
             basis: PhantomData,
         }
+    }
+
+    /// The same kernel with shape-function gradients of the given kind.
+    #[must_use]
+    pub fn with_gradient(mut self, gradient: GradientKind) -> Self {
+        self.gradient = gradient;
+        self
+    }
+
+    /// Which gradient the stencils carry.
+    pub fn gradient(&self) -> GradientKind {
+        self.gradient
     }
 
     /// The mesh.
@@ -189,7 +209,7 @@ where
         let host = locate(&self.mesh, x, cache)?;
         let mut mls = MlsStencil::new();
         self.kernel
-            .evaluate::<N, B>(&self.mesh, host, x, GradientKind::Reconstructed, &mut mls)
+            .evaluate::<N, B>(&self.mesh, host, x, self.gradient, &mut mls)
             .map_err(|e| KernelError::evaluation("UMLS", e))?;
         out.clear();
         for (v, n, g) in mls.iter() {

@@ -7,7 +7,9 @@ use std::sync::Arc;
 use nalgebra::SVector;
 use proptest::prelude::*;
 use umls_kernels::testing::check_kernel;
-use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, Umls1, Umls2, Umls3};
+use umls_kernels::{
+    BSplineKernel, BSplineOrder, GradientKind, LinearFeKernel, Umls1, Umls2, Umls3,
+};
 use umls_mesh::generate::{Diagonal, Lattice};
 use umls_transfer::{Kernel, Stencil};
 
@@ -51,6 +53,7 @@ proptest! {
         let centre = SVector::<f64, 2>::new(0.5, 0.5);
         let (lo, hi) = (SVector::<f64, 2>::zeros(), SVector::<f64, 2>::repeat(1.0));
         conformance(&Umls2::new(mesh.clone()), lo, hi, &f)?;
+        conformance(&Umls2::new(mesh.clone()).with_gradient(GradientKind::Full), lo, hi, &f)?;
         conformance(&LinearFeKernel::new(mesh), lo, hi, &f)?;
         // Same points mapped into the rotated square.
         let mapped: Vec<f64> = f.chunks_exact(2).flat_map(|c| {
@@ -67,6 +70,7 @@ proptest! {
         let mesh = Arc::new(Lattice::new([0.0; 3], [1.0; 3], [4, 4, 4]).jitter(0.2, seed).tetrahedra().unwrap());
         let (lo, hi) = mesh.bounding_box();
         conformance(&Umls3::new(mesh.clone()), lo, hi, &f)?;
+        conformance(&Umls3::new(mesh.clone()).with_gradient(GradientKind::Full), lo, hi, &f)?;
         conformance(&LinearFeKernel::new(mesh), lo, hi, &f)?;
     }
 
@@ -112,6 +116,63 @@ fn bspline_gradients_and_sizes() {
     }
     assert!(BSplineKernel::new(SVector::from([0.0]), -1.0, [10], BSplineOrder::Cubic).is_none());
     assert!(BSplineKernel::new(SVector::from([0.0]), 1.0, [2], BSplineOrder::Cubic).is_none());
+}
+
+/// With `GradientKind::Full` the UMLS stencil's gradients are the derivatives of its
+/// values (central differences inside one host, where the fit is smooth); the default
+/// reconstructed gradient is not, by a margin well above the differencing error; both
+/// carry the same values.
+#[test]
+fn umls_full_gradient_is_the_derivative_of_the_values() {
+    let mesh = Arc::new(
+        Lattice::new([0.0; 3], [1.0; 3], [4, 4, 4])
+            .jitter(0.2, 5)
+            .tetrahedra()
+            .unwrap(),
+    );
+    let full = Umls3::new(mesh.clone()).with_gradient(GradientKind::Full);
+    let reconstructed = Umls3::new(mesh);
+    assert_eq!(reconstructed.gradient(), GradientKind::Reconstructed);
+    let d = 1e-6;
+    let mut largest_gap = 0.0f64;
+    for x in [
+        SVector::<f64, 3>::new(0.41, 0.37, 0.52),
+        SVector::<f64, 3>::new(0.63, 0.28, 0.71),
+    ] {
+        let (mut st, mut rec, mut plus, mut minus) = (
+            Stencil::new(),
+            Stencil::new(),
+            Stencil::new(),
+            Stencil::new(),
+        );
+        full.stencil(&x, &mut Default::default(), &mut st).unwrap();
+        reconstructed
+            .stencil(&x, &mut Default::default(), &mut rec)
+            .unwrap();
+        assert_eq!(st.nodes(), rec.nodes());
+        assert_eq!(st.values(), rec.values());
+        for axis in 0..3 {
+            let e = SVector::<f64, 3>::from_fn(|i, _| if i == axis { d } else { 0.0 });
+            full.stencil(&(x + e), &mut Default::default(), &mut plus)
+                .unwrap();
+            full.stencil(&(x - e), &mut Default::default(), &mut minus)
+                .unwrap();
+            assert_eq!(plus.nodes(), st.nodes(), "the host must not change");
+            for i in 0..st.len() {
+                let fd = (plus.values()[i] - minus.values()[i]) / (2.0 * d);
+                assert!(
+                    (fd - st.gradients()[i][axis]).abs() < 1e-6,
+                    "node {i} axis {axis}: {fd} vs {}",
+                    st.gradients()[i][axis]
+                );
+                largest_gap = largest_gap.max((fd - rec.gradients()[i][axis]).abs());
+            }
+        }
+    }
+    assert!(
+        largest_gap > 1e-2,
+        "the reconstructed gradient differs from the derivative: {largest_gap}"
+    );
 }
 
 /// The suite catches what it checks: hat functions on [0, 1] pass it; scaled values, a
