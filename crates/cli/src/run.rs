@@ -13,7 +13,7 @@ use std::time::Instant;
 use nalgebra::{SMatrix, SVector};
 use serde_json::json;
 use umls_engine::{
-    Apic, Boundary, Diagnostics, EngineError, Flip, Particles, Simulation, StageTimes,
+    Apic, ApicFlip, Boundary, Diagnostics, EngineError, Flip, Particles, Simulation, StageTimes,
     StepSettings, TimeStepControl, TransferScheme, VelocityGradientAffine, Wall,
 };
 use umls_io::csv::HistoryWriter;
@@ -356,13 +356,20 @@ fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
     kernel: K,
     table: MaterialTable<P>,
 ) -> Result<RunReport> {
-    // Two transfer types instead of four halve the simulations this crate compiles: PIC is
-    // FLIP with α = 0 (v = 0·(v + Δv) + 1·v_PIC, the same numbers), and the two affine
-    // schemes share one type.
+    // Three transfer types instead of five keep down the simulations this crate compiles:
+    // PIC is FLIP with α = 0 (v = 0·(v + Δv) + 1·v_PIC, the same numbers), and the two
+    // affine schemes share one type. APIC-FLIP has its own, so that APIC does not read
+    // the old grid velocities it has no use for.
     let t = &ctx.scene.spec.transfer;
+    if !(0.0..=1.0).contains(&t.alpha) {
+        return Err(ctx
+            .scene
+            .value_error("transfer.alpha", format!("{} is not in [0, 1]", t.alpha)));
+    }
     match t.kind {
         TransferKind::Pic => start(ctx, kernel, table, Flip { alpha: 0.0 }),
         TransferKind::Flip => start(ctx, kernel, table, Flip { alpha: t.alpha }),
+        TransferKind::ApicFlip => start(ctx, kernel, table, ApicFlip { alpha: t.alpha }),
         TransferKind::Apic => start(ctx, kernel, table, AffineTransfer::Apic),
         TransferKind::VelocityGradient => {
             start(ctx, kernel, table, AffineTransfer::VelocityGradient)
@@ -597,6 +604,7 @@ fn transfer_name(spec: &crate::schema::TransferSpec) -> String {
     match spec.kind {
         TransferKind::Pic => "pic".into(),
         TransferKind::Flip => format!("flip (alpha {})", spec.alpha),
+        TransferKind::ApicFlip => format!("apic-flip (alpha {})", spec.alpha),
         TransferKind::Apic => "apic".into(),
         TransferKind::VelocityGradient => "velocity-gradient".into(),
     }

@@ -331,6 +331,8 @@ pub enum TransferKind {
     Flip,
     /// APIC.
     Apic,
+    /// FLIP blended with APIC by `alpha`: APIC's affine P2G, FLIP's velocity update.
+    ApicFlip,
     /// Affine transfer with C = ∇v.
     VelocityGradient,
 }
@@ -342,7 +344,7 @@ pub struct TransferSpec {
     /// Which scheme (default `flip`).
     #[serde(default)]
     pub kind: TransferKind,
-    /// FLIP fraction (default 0.99).
+    /// FLIP fraction of `flip` and `apic-flip`, in [0, 1] (default 0.99).
     #[serde(default = "default_alpha")]
     pub alpha: f64,
 }

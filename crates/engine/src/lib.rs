@@ -68,4 +68,6 @@ pub use seeding::{Inside, Region, lattice_points, lattice_samples};
 pub use settings::{Damping, StencilStorage, StepSettings, TimeStepControl};
 pub use simulation::{BodyForce, Simulation};
 pub use timing::StageTimes;
-pub use transfer::{Apic, Flip, Pic, StressUpdate, TransferScheme, VelocityGradientAffine};
+pub use transfer::{
+    Apic, ApicFlip, Flip, Pic, StressUpdate, TransferScheme, VelocityGradientAffine,
+};

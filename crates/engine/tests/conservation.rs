@@ -7,7 +7,7 @@ use std::sync::Arc;
 use nalgebra::{SVector, Vector2};
 use umls_constitutive::{ElasticParameters, NeoHookean};
 use umls_engine::{
-    Apic, Flip, Particles, Pic, Simulation, StepSettings, StressUpdate, TransferScheme,
+    Apic, ApicFlip, Flip, Particles, Pic, Simulation, StepSettings, StressUpdate, TransferScheme,
     VelocityGradientAffine,
 };
 use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, Umls2};
@@ -80,6 +80,7 @@ macro_rules! every_transfer {
             check($kernel, Pic, update);
             check($kernel, Flip { alpha: 0.95 }, update);
             check($kernel, Apic, update);
+            check($kernel, ApicFlip { alpha: 0.95 }, update);
             check($kernel, VelocityGradientAffine, update);
         }
     };

@@ -265,23 +265,26 @@ impl Matrix {
     }
 }
 
-/// The scene edits of a transfer name: `pic`, `apic`, `flip:ALPHA` (`flip` alone is
-/// `flip:1`).
+/// The scene edits of a transfer name: `pic`, `apic`, `flip:ALPHA` and `apic-flip:ALPHA`
+/// (`flip` and `apic-flip` alone have α = 1).
 pub fn transfer_edits(name: &str) -> Option<Vec<String>> {
-    match name.split_once(':') {
-        None if name == "pic" || name == "apic" => Some(vec![format!("transfer.kind={name}")]),
-        None if name == "flip" => Some(vec![
-            "transfer.kind=flip".into(),
-            "transfer.alpha=1.0".into(),
-        ]),
-        Some(("flip", alpha)) => {
-            let a: f64 = alpha.parse().ok()?;
-            (0.0..=1.0)
-                .contains(&a)
-                .then(|| vec!["transfer.kind=flip".into(), format!("transfer.alpha={a:?}")])
+    let (kind, alpha) = match name.split_once(':') {
+        None if name == "pic" || name == "apic" => {
+            return Some(vec![format!("transfer.kind={name}")]);
         }
-        _ => None,
+        None => (name, "1.0"),
+        Some(pair) => pair,
+    };
+    if kind != "flip" && kind != "apic-flip" {
+        return None;
     }
+    let a: f64 = alpha.parse().ok()?;
+    (0.0..=1.0).contains(&a).then(|| {
+        vec![
+            format!("transfer.kind={kind}"),
+            format!("transfer.alpha={a:?}"),
+        ]
+    })
 }
 
 /// A TOML value as axis text: `0.25`, `15`, `"x"` → `x`.
@@ -289,5 +292,42 @@ pub fn value_text(value: &toml::Value) -> String {
     match value {
         toml::Value::String(s) => s.clone(),
         other => other.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::transfer_edits;
+
+    #[test]
+    fn transfer_names_become_scene_edits() {
+        let edits = |name: &str| transfer_edits(name).map(|e| e.join(" "));
+        assert_eq!(edits("apic").as_deref(), Some("transfer.kind=apic"));
+        assert_eq!(edits("pic").as_deref(), Some("transfer.kind=pic"));
+        assert_eq!(
+            edits("flip").as_deref(),
+            Some("transfer.kind=flip transfer.alpha=1.0")
+        );
+        assert_eq!(
+            edits("flip:0.99").as_deref(),
+            Some("transfer.kind=flip transfer.alpha=0.99")
+        );
+        assert_eq!(
+            edits("apic-flip:0.95").as_deref(),
+            Some("transfer.kind=apic-flip transfer.alpha=0.95")
+        );
+        assert_eq!(
+            edits("apic-flip").as_deref(),
+            Some("transfer.kind=apic-flip transfer.alpha=1.0")
+        );
+        for bad in [
+            "flip:1.5",
+            "flip:x",
+            "apic:0.5",
+            "pic-flip:0.5",
+            "flip:-0.1",
+        ] {
+            assert_eq!(edits(bad), None, "{bad}");
+        }
     }
 }
