@@ -236,8 +236,9 @@ fn run_dim<const D: usize, X: Dimension<D>>(
 
 /// The MLS settings of a UMLS kernel and its gradient kind: the kernel name's preset
 /// (profile, radius rule, factor, gradient), with `[kernel]`'s `weight`, `support`,
-/// `support_factor` and `gradient` overriding it. The quadratic basis needs six (2D) or ten (3D) weighted samples, more than a
-/// vertex on a wall or in a corner has, so its quadratic terms carry a small ridge.
+/// `support_factor` and `gradient` overriding it. The quadratic basis needs six (2D) or
+/// ten (3D) weighted samples, more than a vertex on a wall or in a corner has, so its
+/// quadratic terms carry a small ridge.
 fn umls_settings<const D: usize>(
     ctx: &Context<'_, D>,
     mesh: &SimplexMesh<D>,
