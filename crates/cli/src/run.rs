@@ -244,13 +244,13 @@ fn umls_settings<const D: usize>(
     mesh: &SimplexMesh<D>,
 ) -> Result<(UmlsKernel<D, Profile>, GradientKind)> {
     let spec = &ctx.scene.spec.kernel;
-    let (weight, support, factor) = umls_preset(ctx.kernel);
-    let weight = match spec.weight.unwrap_or(weight) {
+    let preset = umls_preset(ctx.kernel);
+    let weight = match spec.weight.unwrap_or(preset.weight) {
         WeightSpec::CubicBspline => Profile::CubicBSpline,
         WeightSpec::Wendland => Profile::WendlandC2,
     };
-    let factor = spec.support_factor.unwrap_or(factor);
-    let support = match spec.support.unwrap_or(support) {
+    let factor = spec.support_factor.unwrap_or(preset.factor);
+    let support = match spec.support.unwrap_or(preset.support) {
         SupportSpec::PerVertex => SupportRadius::PerVertex { factor },
         SupportSpec::IncidentEdge => SupportRadius::IncidentEdge { factor },
         SupportSpec::Global => SupportRadius::Global { factor },
@@ -262,32 +262,49 @@ fn umls_settings<const D: usize>(
     if ctx.kernel == KernelKind::UmlsQuadratic {
         mls.conditioning.higher_order_ridge = QUADRATIC_RIDGE;
     }
-    let preset_gradient = if ctx.kernel == KernelKind::UmlsFullGradient {
-        GradientSpec::Full
-    } else {
-        GradientSpec::Reconstructed
-    };
-    Ok((mls, spec.gradient.unwrap_or(preset_gradient).kind()))
+    Ok((mls, spec.gradient.unwrap_or(preset.gradient).kind()))
 }
 
 /// Relative ridge on the quadratic monomials of `umls-quadratic`.
 const QUADRATIC_RIDGE: f64 = 1e-3;
 
-/// Profile, radius rule and factor of each UMLS kernel name.
-fn umls_preset(kind: KernelKind) -> (WeightSpec, SupportSpec, f64) {
+/// What a UMLS kernel name stands for; `[kernel]`'s keys override each part.
+struct UmlsPreset {
+    weight: WeightSpec,
+    support: SupportSpec,
+    factor: f64,
+    gradient: GradientSpec,
+}
+
+/// Profile, radius rule, factor and gradient of each UMLS kernel name: the default
+/// `umls` with the one part the name changes.
+fn umls_preset(kind: KernelKind) -> UmlsPreset {
+    let default = UmlsPreset {
+        weight: WeightSpec::CubicBspline,
+        support: SupportSpec::IncidentEdge,
+        factor: DEFAULT_SUPPORT_FACTOR,
+        gradient: GradientSpec::Reconstructed,
+    };
     match kind {
-        KernelKind::UmlsWide => (WeightSpec::CubicBspline, SupportSpec::PerVertex, 1.0),
-        KernelKind::UmlsPaper => (WeightSpec::CubicBspline, SupportSpec::Global, 1.0),
-        KernelKind::UmlsWendland => (
-            WeightSpec::Wendland,
-            SupportSpec::IncidentEdge,
-            DEFAULT_SUPPORT_FACTOR,
-        ),
-        _ => (
-            WeightSpec::CubicBspline,
-            SupportSpec::IncidentEdge,
-            DEFAULT_SUPPORT_FACTOR,
-        ),
+        KernelKind::UmlsWide => UmlsPreset {
+            support: SupportSpec::PerVertex,
+            factor: 1.0,
+            ..default
+        },
+        KernelKind::UmlsPaper => UmlsPreset {
+            support: SupportSpec::Global,
+            factor: 1.0,
+            ..default
+        },
+        KernelKind::UmlsWendland => UmlsPreset {
+            weight: WeightSpec::Wendland,
+            ..default
+        },
+        KernelKind::UmlsFullGradient => UmlsPreset {
+            gradient: GradientSpec::Full,
+            ..default
+        },
+        _ => default,
     }
 }
 

@@ -301,25 +301,23 @@ mod tests {
 
     #[test]
     fn transfer_names_become_scene_edits() {
-        let edits = |name: &str| transfer_edits(name).map(|e| e.join(" "));
-        assert_eq!(edits("apic").as_deref(), Some("transfer.kind=apic"));
-        assert_eq!(edits("pic").as_deref(), Some("transfer.kind=pic"));
-        assert_eq!(
-            edits("flip").as_deref(),
-            Some("transfer.kind=flip transfer.alpha=1.0")
-        );
-        assert_eq!(
-            edits("flip:0.99").as_deref(),
-            Some("transfer.kind=flip transfer.alpha=0.99")
-        );
-        assert_eq!(
-            edits("apic-flip:0.95").as_deref(),
-            Some("transfer.kind=apic-flip transfer.alpha=0.95")
-        );
-        assert_eq!(
-            edits("apic-flip").as_deref(),
-            Some("transfer.kind=apic-flip transfer.alpha=1.0")
-        );
+        for (name, expected) in [
+            ("apic", "transfer.kind=apic"),
+            ("pic", "transfer.kind=pic"),
+            ("flip", "transfer.kind=flip transfer.alpha=1.0"),
+            ("flip:0.99", "transfer.kind=flip transfer.alpha=0.99"),
+            (
+                "apic-flip:0.95",
+                "transfer.kind=apic-flip transfer.alpha=0.95",
+            ),
+            ("apic-flip", "transfer.kind=apic-flip transfer.alpha=1.0"),
+        ] {
+            assert_eq!(
+                transfer_edits(name).map(|e| e.join(" ")).as_deref(),
+                Some(expected),
+                "{name}"
+            );
+        }
         for bad in [
             "flip:1.5",
             "flip:x",
@@ -327,7 +325,7 @@ mod tests {
             "pic-flip:0.5",
             "flip:-0.1",
         ] {
-            assert_eq!(edits(bad), None, "{bad}");
+            assert_eq!(transfer_edits(bad), None, "{bad}");
         }
     }
 }
