@@ -4,7 +4,7 @@
 //! reported.
 
 use nalgebra::SVector;
-use umls_engine::{Wall, WallKind};
+use umls_engine::{FittedClamp, Wall, WallKind};
 
 use crate::error::Result;
 use crate::run::{Context, Run};
@@ -96,7 +96,11 @@ pub(crate) fn apply_boundaries<const D: usize>(
                 let nodes = vertices.iter().map(|(v, _)| *v).collect();
                 sim.boundary().reaction_sets.push(nodes);
             }
-            BoundaryTarget::Region { region, normal } => {
+            BoundaryTarget::Region {
+                region,
+                normal,
+                fitted,
+            } => {
                 let frame = &ctx.setup.frame;
                 let nodes: Vec<u32> = sim
                     .node_positions()
@@ -112,6 +116,24 @@ pub(crate) fn apply_boundaries<const D: usize>(
                     ));
                 }
                 match normal {
+                    None if *fitted => {
+                        let particles: Vec<u32> = sim
+                            .positions()
+                            .iter()
+                            .enumerate()
+                            .filter(|(_, x)| region.contains(&frame.point_to_scene(x)))
+                            .map(|(p, _)| p as u32)
+                            .collect();
+                        if particles.is_empty() {
+                            return Err(scene.value_error(
+                                format!("boundaries[{i}].imposed"),
+                                "a clamp imposed on the fit needs particles inside its region",
+                            ));
+                        }
+                        let mut clamp = FittedClamp::new(nodes.clone(), particles);
+                        clamp.reach = sim.spacing();
+                        sim.boundary().fitted.push(clamp);
+                    }
                     None => sim.boundary().fixed.extend(nodes.iter().copied()),
                     Some(n) => sim.boundary().slip.extend(nodes.iter().map(|&v| (v, *n))),
                 }

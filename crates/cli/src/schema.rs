@@ -708,6 +708,20 @@ pub struct BoundarySpec {
     pub region: Option<RegionSpec>,
     /// The wall normal of a slip condition on a region.
     pub normal: Option<Vec<f64>>,
+    /// How a fixed region holds the body: on its nodes (default) or on the fit.
+    pub imposed: Option<Imposed>,
+}
+
+/// `imposed` of a fixed region: where the zero velocity is imposed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Imposed {
+    /// Every kernel node inside the region is at rest (a staircase of whole cells).
+    Nodes,
+    /// The region's nodes take the velocities under which the velocity interpolated at
+    /// the particles inside the region vanishes, in the mass-weighted least-squares
+    /// sense (`umls_engine::FittedClamp`): the clamp ends where those particles end.
+    Fit,
 }
 
 /// `[reference]`: an analytic velocity field v(X, t) or displacement u(X, t) at the

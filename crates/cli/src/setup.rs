@@ -21,8 +21,8 @@ use crate::hydrostatic::Hydrostatic;
 use crate::probes::ProbeReference;
 use crate::scene::Scene;
 use crate::schema::{
-    BoundaryKind, DiagonalSpec, MaterialSpec, QuadratureSpec, RegionSpec, SeedingSpec, SolidSpec,
-    StressUpdateSpec,
+    BoundaryKind, DiagonalSpec, Imposed, MaterialSpec, QuadratureSpec, RegionSpec, SeedingSpec,
+    SolidSpec, StressUpdateSpec,
 };
 use umls_constitutive::table::{ElasticModel, Model, PlasticModel};
 
@@ -66,6 +66,8 @@ pub enum BoundaryTarget<const D: usize> {
         region: Region<D>,
         /// Unit normal (slip only).
         normal: Option<SVector<f64, D>>,
+        /// A fixed region imposed on the fit at the particles inside it, not on its nodes.
+        fitted: bool,
     },
 }
 
@@ -662,6 +664,12 @@ pub fn build_for<const D: usize>(
     }
     let mut boundaries = Vec::new();
     for (i, b) in spec.boundaries.iter().enumerate() {
+        if b.imposed.is_some() && b.region.is_none() {
+            return Err(scene.value_error(
+                format!("boundaries[{i}].imposed"),
+                "only a `region` condition takes `imposed`",
+            ));
+        }
         if b.normal.is_some() && b.region.is_none() {
             return Err(scene.value_error(
                 format!("boundaries[{i}].normal"),
@@ -696,9 +704,20 @@ pub fn build_for<const D: usize>(
                         ));
                     }
                 };
+                let fitted = match (b.imposed, b.kind) {
+                    (None | Some(Imposed::Nodes), _) => false,
+                    (Some(Imposed::Fit), BoundaryKind::Fixed) => true,
+                    (Some(Imposed::Fit), BoundaryKind::Slip) => {
+                        return Err(scene.value_error(
+                            format!("boundaries[{i}].imposed"),
+                            "only a fixed region can be imposed on the fit",
+                        ));
+                    }
+                };
                 BoundaryTarget::Region {
                     region: region(scene, &format!("boundaries[{i}].region"), spec)?,
                     normal,
+                    fitted,
                 }
             }
             (Some(plane), None, None) => {

@@ -16,6 +16,8 @@
 use nalgebra::SVector;
 use umls_transfer::{DomainExit, Kernel};
 
+use crate::fitted_clamp::FittedClamp;
+
 /// Per-node marks of [`Boundary::node_marks`].
 const SLIP: u8 = 1;
 const FIXED: u8 = 2;
@@ -94,6 +96,9 @@ pub struct Boundary<const D: usize> {
     /// user wants to read; a node in two sets counts in both). See
     /// [`crate::Simulation::reactions`].
     pub reaction_sets: Vec<Vec<u32>>,
+    /// Clamps imposed on the fit: their nodes take the velocities under which the
+    /// velocity at their particles vanishes ([`FittedClamp`]).
+    pub fitted: Vec<FittedClamp>,
 }
 
 /// The force the constraints of one reaction set exert on the body in the last step.
@@ -172,7 +177,7 @@ impl<const D: usize> Boundary<D> {
 
     /// Whether any node condition is set (walls given as node sets, such as mesh groups).
     pub(crate) fn has_node_conditions(&self) -> bool {
-        !self.fixed.is_empty() || !self.slip.is_empty()
+        !self.fixed.is_empty() || !self.slip.is_empty() || !self.fitted.is_empty()
     }
 
     /// Marks per node: fixed, slip, or free.
@@ -181,7 +186,11 @@ impl<const D: usize> Boundary<D> {
         for (node, _) in &self.slip {
             marks[*node as usize] |= SLIP;
         }
-        for &node in &self.fixed {
+        for &node in self
+            .fixed
+            .iter()
+            .chain(self.fitted.iter().flat_map(|c| c.nodes()))
+        {
             marks[node as usize] |= FIXED;
         }
         marks

@@ -5,7 +5,8 @@
 //! One [`Simulation::step`]: evaluate every particle's stencil (in parallel, walking from
 //! its cached host), P2G of mass, momentum (with the affine term for affine schemes) and
 //! force (−Σ V⁰ τ ∇N + gravity and body forces), grid update (empty and mass-scaled nodes,
-//! damping, boundary conditions), G2P of velocity, affine matrix and position, walls that
+//! damping, boundary conditions: node sets, walls, clamps imposed on the fit
+//! ([`FittedClamp`])), G2P of velocity, affine matrix and position, walls that
 //! hold the particles, then F ← (I + Δt∇v)F and the material's return map (USL, or MUSL
 //! with re-mapped momenta). The time step is fixed or adaptive
 //! ([`Simulation::stable_time_step`]: one definition for every kernel). Failures stop the
@@ -46,6 +47,7 @@
 mod boundary;
 mod diagnostics;
 mod error;
+mod fitted_clamp;
 pub mod geostatic;
 mod grid;
 mod memory;
@@ -62,6 +64,7 @@ mod transfer;
 pub use boundary::{Boundary, Reaction, Wall, WallKind};
 pub use diagnostics::Diagnostics;
 pub use error::EngineError;
+pub use fitted_clamp::{FITTED_CLAMP_REGULARISATION, FittedClamp};
 pub use memory::MemoryUse;
 pub use particles::Particles;
 pub use seeding::{Inside, Region, lattice_points, lattice_samples};

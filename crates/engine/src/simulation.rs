@@ -19,6 +19,7 @@ use crate::transfer::{StressUpdate, TransferScheme};
 
 mod checks;
 mod constitutive;
+mod fitted_clamps;
 mod grid_to_particles;
 mod musl;
 mod particles_to_grid;
@@ -490,14 +491,33 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             self.reactions.1.clear();
             self.reactions.0.nodal.clear();
         }
+        // Fitted clamps change node velocities after the update, so with them the
+        // reactions are taken around both.
+        let fitted = !self.boundary.fitted.is_empty();
+        if measure && fitted {
+            self.reactions
+                .0
+                .record(&self.boundary, &self.grid.momentum, &self.grid.force, dt);
+        }
         let report = self.grid.update(
             dt,
             self.material.p_wave_modulus(),
             self.settings.cancellation_fraction,
             self.settings.damping,
             &self.boundary,
-            measure.then_some(&mut self.reactions),
+            (measure && !fitted).then_some(&mut self.reactions),
         );
+        self.apply_fitted_clamps()?;
+        if measure && fitted {
+            let (scratch, out) = &mut self.reactions;
+            scratch.reactions(
+                &self.boundary,
+                &self.grid.mass,
+                &self.grid.new_velocity,
+                dt,
+                out,
+            );
+        }
         self.totals.dropped_mass += report.dropped_mass;
         self.totals.redistributed_momentum += report.redistributed_momentum;
         self.totals.mass_scaled_nodes += report.scaled_nodes;

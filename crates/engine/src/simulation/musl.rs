@@ -44,6 +44,12 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             };
         }
         self.boundary.apply(&mut g.velocity);
+        let rows = self.fitted_clamp_rows()?;
+        let g = &mut self.grid;
+        for (clamp, rows) in self.boundary.fitted.iter().zip(&rows) {
+            clamp.fit(rows, &mut g.velocity);
+        }
+        let (p, kernel, stencils) = (&self.particles, &self.kernel, &self.stencils);
         let v = &g.velocity;
         self.velocity_gradients
             .par_iter_mut()

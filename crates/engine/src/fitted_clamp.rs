@@ -1,0 +1,141 @@
+//! A clamp imposed on the velocity fit instead of on nodes.
+//!
+//! A fixed region given as nodes (every node inside it at rest) is a staircase of whole
+//! cells: where its edge falls depends on how the mesh or grid lies under the body, and
+//! with kernels that do not interpolate (UMLS, B-splines) the velocity interpolated at
+//! the embedded particles next to the edge is not zero. A [`FittedClamp`] instead gives
+//! its region's nodes the velocities under which the clamped particles neither move nor
+//! deform, in the mass-weighted least-squares sense, given the free nodes' velocities:
+//!
+//! min over v_c (c in the clamp's nodes) of
+//! Σ_p m_p (|Σ_i N_ip v_i|² + ℓ² |Σ_i v_i ⊗ ∇N_ip|²) + ε s Σ_c |v_c|²,
+//!
+//! where p runs over the clamped particles, i over all nodes of their stencils, ℓ is the
+//! kernel's spacing and s the largest diagonal entry of the normal matrix. The clamped
+//! particles are the material the clamp holds, so they move with the body, not with the
+//! mesh: the clamp ends where they end, whatever the node layout.
+//!
+//! The velocity-gradient term is what keeps the clamp stable: with values alone, node
+//! patterns that vanish at every clamped particle but not between them are free, and on
+//! refined cantilevers they grew until the energy check stopped the run
+//! (docs/umls-kernel.md has the measurements). The Tikhonov term (ε =
+//! [`FITTED_CLAMP_REGULARISATION`]) only keeps the normal matrix regular.
+
+use nalgebra::{DMatrix, DVector, SVector};
+
+/// Relative weight ε of the Tikhonov term that keeps the normal matrix regular.
+pub const FITTED_CLAMP_REGULARISATION: f64 = 1e-6;
+
+/// A clamp imposed on the fit: `nodes` (sorted, without repeats) carry the velocities
+/// under which the velocity and its gradient at `particles` vanish (least squares).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FittedClamp {
+    nodes: Vec<u32>,
+    particles: Vec<u32>,
+    /// The length ℓ that weighs the velocity-gradient rows against the velocity rows
+    /// (default 1; give the kernel's spacing, as the command line does).
+    pub reach: f64,
+}
+
+/// One clamped particle's stencil: its mass, and (node, value, gradient) triples.
+pub(crate) struct ClampRow<const D: usize> {
+    pub mass: f64,
+    pub entries: Vec<(u32, f64, SVector<f64, D>)>,
+}
+
+impl FittedClamp {
+    /// A clamp whose `nodes` are fitted so that the velocity vanishes at `particles`
+    /// (indices into the simulation's particles). Repeated indices are merged.
+    pub fn new(mut nodes: Vec<u32>, mut particles: Vec<u32>) -> Self {
+        nodes.sort_unstable();
+        nodes.dedup();
+        particles.sort_unstable();
+        particles.dedup();
+        Self {
+            nodes,
+            particles,
+            reach: 1.0,
+        }
+    }
+
+    /// The nodes whose velocities are fitted.
+    pub fn nodes(&self) -> &[u32] {
+        &self.nodes
+    }
+
+    /// The particles at which the velocity is made to vanish.
+    pub fn particles(&self) -> &[u32] {
+        &self.particles
+    }
+
+    /// Fits the clamp's nodes of `velocity` to the clamped particles' stencils `rows`:
+    /// nodes the rows do not reach are set to rest, the others to the regularised
+    /// least-squares solution given the other nodes' velocities.
+    pub(crate) fn fit<const D: usize>(
+        &self,
+        rows: &[ClampRow<D>],
+        velocity: &mut [SVector<f64, D>],
+    ) {
+        for &n in &self.nodes {
+            velocity[n as usize] = SVector::zeros();
+        }
+        // Unknowns: the clamp's nodes the rows reach, numbered in node order.
+        let mut unknowns: Vec<u32> = rows
+            .iter()
+            .flat_map(|r| r.entries.iter().map(|e| e.0))
+            .filter(|n| self.nodes.binary_search(n).is_ok())
+            .collect();
+        unknowns.sort_unstable();
+        unknowns.dedup();
+        let k = unknowns.len();
+        if k == 0 {
+            return;
+        }
+        let index = |n: u32| unknowns.binary_search(&n).ok();
+        let mut normal = DMatrix::<f64>::zeros(k, k);
+        let mut rhs = vec![DVector::<f64>::zeros(k); D];
+        let mut local: Vec<(usize, f64)> = Vec::new();
+        // One least-squares row Σ_i c_i v_i = 0 over a particle's nodes, weighted by
+        // `weight`: the clamp's nodes are unknown, the free nodes' part is the target.
+        let mut add_row = |weight: f64, coefficients: &mut dyn Iterator<Item = (u32, f64)>| {
+            let mut target = SVector::<f64, D>::zeros();
+            local.clear();
+            for (n, c) in coefficients {
+                match index(n) {
+                    Some(j) => local.push((j, c)),
+                    None => target -= velocity[n as usize] * c,
+                }
+            }
+            for &(a, ca) in &local {
+                for &(b, cb) in &local {
+                    normal[(a, b)] += weight * ca * cb;
+                }
+                for (d, r) in rhs.iter_mut().enumerate() {
+                    r[a] += weight * ca * target[d];
+                }
+            }
+        };
+        for row in rows {
+            add_row(row.mass, &mut row.entries.iter().map(|e| (e.0, e.1)));
+            for d in 0..D {
+                add_row(
+                    row.mass,
+                    &mut row.entries.iter().map(|e| (e.0, e.2[d] * self.reach)),
+                );
+            }
+        }
+        let scale = (0..k).map(|j| normal[(j, j)]).fold(0.0, f64::max);
+        for j in 0..k {
+            normal[(j, j)] += FITTED_CLAMP_REGULARISATION * scale;
+        }
+        let Some(cholesky) = normal.cholesky() else {
+            return;
+        };
+        for (d, r) in rhs.into_iter().enumerate() {
+            let x = cholesky.solve(&r);
+            for (j, &n) in unknowns.iter().enumerate() {
+                velocity[n as usize][d] = x[j];
+            }
+        }
+    }
+}

@@ -1,0 +1,62 @@
+//! Part of stage 3, the grid update: clamps imposed on the fit ([`FittedClamp`]) set
+//! their nodes' velocities from the clamped particles' stencils.
+//!
+//! [`FittedClamp`]: crate::FittedClamp
+
+use umls_constitutive::Constitutive;
+use umls_transfer::{Kernel, Stencil};
+
+use super::Simulation;
+use crate::error::EngineError;
+use crate::fitted_clamp::ClampRow;
+use crate::transfer::TransferScheme;
+
+impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
+    /// Fits the clamps' nodes in the grid velocities before and after the update (so a
+    /// FLIP increment vanishes at the clamped particles as well as the velocity).
+    pub(super) fn apply_fitted_clamps(&mut self) -> Result<(), EngineError> {
+        for (clamp, rows) in self.boundary.fitted.iter().zip(self.fitted_clamp_rows()?) {
+            clamp.fit(&rows, &mut self.grid.velocity);
+            clamp.fit(&rows, &mut self.grid.new_velocity);
+        }
+        Ok(())
+    }
+
+    /// The clamped particles' stencils of this step, one list per clamp.
+    pub(super) fn fitted_clamp_rows(&self) -> Result<Vec<Vec<ClampRow<D>>>, EngineError> {
+        let step = self.step;
+        let (p, kernel, stencils) = (&self.particles, &self.kernel, &self.stencils);
+        let mut scratch = Stencil::new();
+        let mut all = Vec::with_capacity(self.boundary.fitted.len());
+        for clamp in &self.boundary.fitted {
+            let mut rows = Vec::with_capacity(clamp.particles().len());
+            for &i in clamp.particles() {
+                let i = i as usize;
+                if i >= p.len() {
+                    return Err(EngineError::InvalidParameter {
+                        parameter: "fitted clamp particle index",
+                        value: i as f64,
+                        reason: "names a particle beyond the particle count",
+                    });
+                }
+                let entries = stencils
+                    .with(i, kernel, &p.position[i], &p.cache[i], &mut scratch, |st| {
+                        (0..st.len())
+                            .map(|e| (st.nodes[e], st.values[e], st.gradients[e]))
+                            .collect::<Vec<_>>()
+                    })
+                    .map_err(|(particle, source)| EngineError::Kernel {
+                        step,
+                        particle,
+                        source,
+                    })?;
+                rows.push(ClampRow {
+                    mass: p.mass[i],
+                    entries,
+                });
+            }
+            all.push(rows);
+        }
+        Ok(all)
+    }
+}
