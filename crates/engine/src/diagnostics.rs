@@ -77,6 +77,10 @@ pub(crate) struct Totals<const D: usize> {
     pub min_density: f64,
     /// The particle that moved farthest in the last step, and how far.
     pub longest_move: (usize, f64),
+    /// The fastest particle after the last G2P (the first among equals) and its speed².
+    pub fastest: (usize, f64),
+    /// The first particle whose velocity or position G2P left non-finite.
+    pub first_non_finite: Option<usize>,
 }
 
 impl<const D: usize> Default for Totals<D> {
@@ -92,6 +96,8 @@ impl<const D: usize> Default for Totals<D> {
             max_speed: 0.0,
             min_density: f64::INFINITY,
             longest_move: (0, 0.0),
+            fastest: (0, 0.0),
+            first_non_finite: None,
         }
     }
 }

@@ -9,17 +9,16 @@ use crate::error::EngineError;
 use crate::transfer::TransferScheme;
 
 impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
-    /// NaN and Courant checks after a step; records speed and density for the next Δt.
+    /// NaN and Courant checks after a step (from what G2P gathered); records speed and
+    /// density for the next Δt.
     pub(super) fn check_particles(
         &mut self,
         step: usize,
         dt: f64,
         min_density: f64,
     ) -> Result<(), EngineError> {
-        let p = &self.particles;
-        if let Some(i) = (0..p.len())
-            .find(|&i| !(p.velocity[i].iter().chain(p.position[i].iter())).all(|c| c.is_finite()))
-        {
+        // G2P gathered the first non-finite particle and the fastest one.
+        if let Some(i) = self.totals.first_non_finite {
             return Err(EngineError::NonFinite {
                 step,
                 field: "velocity or position",
@@ -27,13 +26,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 index: i,
             });
         }
-        // The fastest particle, the first one among equals.
-        let (fastest, max_speed) = p
-            .velocity
-            .iter()
-            .map(|v| v.norm_squared())
-            .enumerate()
-            .fold((0, 0.0), |a, (i, s)| if s > a.1 { (i, s) } else { a });
+        let (fastest, max_speed) = self.totals.fastest;
         let max_speed = max_speed.max(0.0).sqrt();
         let h = self.kernel.spacing();
         let (mover, moved) = self.totals.longest_move;

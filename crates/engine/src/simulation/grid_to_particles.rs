@@ -82,9 +82,20 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
     }
 }
 
-/// One chunk's share of the G2P totals: work of the body loads, the longest move
-/// (particle, distance), and the wall corrections.
-type ChunkTotals = (f64, (usize, f64), usize);
+/// One chunk's share of the G2P totals.
+#[derive(Debug, Clone, Copy)]
+struct ChunkTotals {
+    /// Work of the body loads.
+    power: f64,
+    /// The longest move (particle, distance).
+    longest: (usize, f64),
+    /// Particles the walls put back.
+    corrections: usize,
+    /// The fastest particle (the first among equals) and its speed².
+    fastest: (usize, f64),
+    /// The first particle left with a non-finite velocity or position.
+    non_finite: Option<usize>,
+}
 
 impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
     /// G2P and the walls; the velocity gradients go to `self.velocity_gradients`.
@@ -124,6 +135,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     // can differ from the stored one): the Courant check reads it.
                     let mut longest = (0, 0.0f64);
                     let mut corrections = 0;
+                    // What the step's checks read, gathered here while the particle is
+                    // in cache instead of in a serial pass after the step.
+                    let mut fastest = (0, 0.0f64);
+                    let mut non_finite = None;
                     for k in 0..velocity.len() {
                         let i = c * chunk + k;
                         let x = position[k];
@@ -156,8 +171,26 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                 }
                             }
                         }
+                        let speed = velocity[k].norm_squared();
+                        if speed > fastest.1 {
+                            fastest = (i, speed);
+                        }
+                        if non_finite.is_none()
+                            && !velocity[k]
+                                .iter()
+                                .chain(position[k].iter())
+                                .all(|c| c.is_finite())
+                        {
+                            non_finite = Some(i);
+                        }
                     }
-                    Ok(vec![(power, longest, corrections)])
+                    Ok(vec![ChunkTotals {
+                        power,
+                        longest,
+                        corrections,
+                        fastest,
+                        non_finite,
+                    }])
                 },
             )
             .reduce(
@@ -177,15 +210,23 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         })?;
         let mut power = 0.0;
         let mut longest = (0, 0.0f64);
-        for (chunk_power, chunk_longest, corrections) in partials {
-            power += chunk_power;
-            if chunk_longest.1 > longest.1 {
-                longest = chunk_longest;
+        let mut fastest = (0, 0.0f64);
+        let mut non_finite = None;
+        for chunk in partials {
+            power += chunk.power;
+            if chunk.longest.1 > longest.1 {
+                longest = chunk.longest;
             }
-            self.totals.wall_corrections += corrections;
+            if chunk.fastest.1 > fastest.1 {
+                fastest = chunk.fastest;
+            }
+            non_finite = non_finite.or(chunk.non_finite);
+            self.totals.wall_corrections += chunk.corrections;
         }
         self.totals.external_work += power * dt;
         self.totals.longest_move = longest;
+        self.totals.fastest = fastest;
+        self.totals.first_non_finite = non_finite;
         Ok(())
     }
 }
