@@ -102,13 +102,16 @@ pub(crate) fn apply_boundaries<const D: usize>(
                 fitted,
             } => {
                 let frame = &ctx.setup.frame;
-                let nodes: Vec<u32> = sim
-                    .node_positions()
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, x)| region.contains(&frame.point_to_scene(x)))
-                    .map(|(n, _)| n as u32)
-                    .collect();
+                // Indices of the points (world frame) inside the region (scene frame).
+                let inside = |points: &[SVector<f64, D>]| -> Vec<u32> {
+                    points
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, x)| region.contains(&frame.point_to_scene(x)))
+                        .map(|(n, _)| n as u32)
+                        .collect()
+                };
+                let nodes = inside(&sim.node_positions());
                 if nodes.is_empty() {
                     return Err(scene.value_error(
                         format!("boundaries[{i}].region"),
@@ -117,13 +120,7 @@ pub(crate) fn apply_boundaries<const D: usize>(
                 }
                 match normal {
                     None if *fitted => {
-                        let particles: Vec<u32> = sim
-                            .positions()
-                            .iter()
-                            .enumerate()
-                            .filter(|(_, x)| region.contains(&frame.point_to_scene(x)))
-                            .map(|(p, _)| p as u32)
-                            .collect();
+                        let particles = inside(sim.positions());
                         if particles.is_empty() {
                             return Err(scene.value_error(
                                 format!("boundaries[{i}].imposed"),

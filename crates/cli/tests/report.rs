@@ -49,6 +49,7 @@ scene = "hydrostatic-column"
 end_time = 0.002
 kernels = ["umls"]
 threads = [1, 2]
+repeats = 2
 "#;
 
 #[test]
@@ -67,8 +68,9 @@ fn a_tiny_matrix_makes_a_complete_report() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(run.status.success(), "{stderr}");
-    // Progress names every run: 4 bar runs, 2 stability cells, 2 histories, 2 throughput.
-    assert!(stderr.contains("[10/10]"), "{stderr}");
+    // Progress names every run: 4 bar runs, 2 stability cells, 2 histories, and 2
+    // throughput measurements run twice each.
+    assert!(stderr.contains("[12/12]"), "{stderr}");
 
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     for kernel in ["umls", "bspline2", "linear-fe"] {
@@ -101,7 +103,7 @@ fn a_tiny_matrix_makes_a_complete_report() {
     let header = reader.headers().unwrap().clone();
     let column = |name: &str| header.iter().position(|h| h == name).unwrap();
     let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
-    assert_eq!(rows.len(), 10);
+    assert_eq!(rows.len(), 12);
     let bar_metrics: Vec<f64> = rows
         .iter()
         .filter(|r| &r[column("study")] == "bar")
@@ -152,8 +154,39 @@ fn a_tiny_matrix_makes_a_complete_report() {
         .parse()
         .unwrap();
     assert_eq!(first, 1.0);
-    // Throughput rows carry the stage breakdown and, on 2 threads, the speed-up.
+    // Throughput rows carry the stage breakdown and, on 2 threads, the speed-up; each
+    // measurement appears once, as the faster of its two runs.
     assert!(report.contains("speed-up over 1 thread"));
+    let throughput = &report[report.find("### Column throughput").unwrap()..];
+    let shown: Vec<(usize, f64)> = throughput
+        .lines()
+        .filter(|l| l.starts_with("| umls |"))
+        .filter_map(|l| {
+            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+            Some((cells[3].parse().ok()?, cells[5].parse().ok()?))
+        })
+        .collect();
+    assert_eq!(shown.len(), 2, "{report}");
+    for (threads, rate) in shown {
+        let runs: Vec<f64> = rows
+            .iter()
+            .filter(|r| {
+                &r[column("study")] == "column" && r[column("threads")] == *threads.to_string()
+            })
+            .map(|r| {
+                r[column("particle_steps_per_second")]
+                    .parse::<f64>()
+                    .unwrap()
+                    / 1e6
+            })
+            .collect();
+        assert_eq!(runs.len(), 2);
+        let fastest = runs.iter().copied().fold(0.0, f64::max);
+        assert!(
+            (rate - fastest).abs() <= 0.01 * fastest,
+            "{threads} threads: {rate} shown, runs {runs:?}"
+        );
+    }
     assert!(report.contains("No criterion results under"));
     // Frames are removed, summaries kept.
     let runs = out.join("runs");
@@ -171,21 +204,27 @@ fn a_tiny_matrix_makes_a_complete_report() {
 fn a_bad_matrix_names_its_key() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("report-bad");
     std::fs::create_dir_all(&dir).unwrap();
-    let matrix = dir.join("bad.toml");
-    std::fs::write(
-        &matrix,
-        "title = \"x\"\n[[accuracy]]\nname = \"a\"\ntitle = \"A\"\nscene = \"vortex\"\nmetric = \"m\"\nmetric_label = \"m\"\nkernels = [\"umls\"]\ntransfers = [\"flop\"]\nrefine = [1]\nh = 0.1\n",
-    )
-    .unwrap();
-    let run = Command::new(env!("CARGO_BIN_EXE_umls"))
-        .args(["report", "--matrix", matrix.to_str().unwrap(), "--out"])
-        .arg(dir.join("out"))
-        .output()
-        .unwrap();
-    assert!(!run.status.success());
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    assert!(
-        stderr.contains("a.transfers") && stderr.contains("flop"),
-        "{stderr}"
-    );
+    for (text, key, value) in [
+        (
+            "title = \"x\"\n[[accuracy]]\nname = \"a\"\ntitle = \"A\"\nscene = \"vortex\"\nmetric = \"m\"\nmetric_label = \"m\"\nkernels = [\"umls\"]\ntransfers = [\"flop\"]\nrefine = [1]\nh = 0.1\n",
+            "a.transfers",
+            "flop",
+        ),
+        (
+            "title = \"x\"\n[[throughput]]\nname = \"t\"\ntitle = \"T\"\nscene = \"vortex\"\nkernels = [\"umls\"]\nthreads = [1]\nrepeats = 0\n",
+            "t.repeats",
+            "at least one",
+        ),
+    ] {
+        let matrix = dir.join("bad.toml");
+        std::fs::write(&matrix, text).unwrap();
+        let run = Command::new(env!("CARGO_BIN_EXE_umls"))
+            .args(["report", "--matrix", matrix.to_str().unwrap(), "--out"])
+            .arg(dir.join("out"))
+            .output()
+            .unwrap();
+        assert!(!run.status.success());
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(stderr.contains(key) && stderr.contains(value), "{stderr}");
+    }
 }

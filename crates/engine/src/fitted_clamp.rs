@@ -20,6 +20,10 @@
 //! refined cantilevers they grew until the energy check stopped the run
 //! (docs/umls-kernel.md has the measurements). The Tikhonov term (ε =
 //! [`FITTED_CLAMP_REGULARISATION`]) only keeps the normal matrix regular.
+//!
+//! The normal matrix is dense over the clamp nodes the clamped particles reach and is
+//! factorised every step (twice: for v and ṽ), so the cost grows with the cube of that
+//! count: meant for clamps of up to a few thousand nodes (the cantilever's has 50–150).
 
 use nalgebra::{DMatrix, DVector, SVector};
 

@@ -40,6 +40,9 @@ pub struct Case {
     pub end_time: Option<f64>,
     /// Worker threads.
     pub threads: usize,
+    /// Which repetition of a throughput measurement (0 for the first and for every other
+    /// kind of study).
+    pub repeat: usize,
     /// `KEY=VALUE` scene edits, in order (study, transfer, variant, sweep).
     pub set: Vec<String>,
     /// Column and row of a stability map, with their values as text.
@@ -59,6 +62,9 @@ impl Case {
             parts.push(format!("x{x}y{y}"));
         }
         parts.push(format!("t{}", self.threads));
+        if self.repeat > 0 {
+            parts.push(format!("rep{}", self.repeat));
+        }
         parts
             .iter()
             .filter(|p| !p.is_empty())
@@ -117,6 +123,7 @@ fn base(common: &Common, kind: StudyKind, kernel: &str, transfer: &str, threads:
         particle_refine: 1.0,
         end_time: common.end_time,
         threads,
+        repeat: 0,
         set,
         cell: None,
     }
@@ -211,20 +218,26 @@ pub fn cases(matrix: &Matrix) -> Vec<Case> {
             }
         }
     }
+    // Repetitions outermost, thread counts innermost: every repetition measures each
+    // size at every thread count back to back, and the repetitions are spread over the
+    // study, so a spell of load on the machine slows one of them, not all.
     for study in &matrix.throughput {
-        for kernel in &study.common.kernels {
-            for transfer in transfers(&study.common) {
-                for &refine in &study.refine {
-                    for &threads in &study.threads {
-                        let mut case = base(
-                            &study.common,
-                            StudyKind::Throughput,
-                            kernel,
-                            &transfer,
-                            threads,
-                        );
-                        case.refine = refine;
-                        out.push(case);
+        for repeat in 0..study.repeats {
+            for kernel in &study.common.kernels {
+                for transfer in transfers(&study.common) {
+                    for &refine in &study.refine {
+                        for &threads in &study.threads {
+                            let mut case = base(
+                                &study.common,
+                                StudyKind::Throughput,
+                                kernel,
+                                &transfer,
+                                threads,
+                            );
+                            case.refine = refine;
+                            case.repeat = repeat;
+                            out.push(case);
+                        }
                     }
                 }
             }

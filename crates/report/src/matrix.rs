@@ -165,6 +165,14 @@ pub struct ThroughputStudy {
     /// Refinement factors (sizes).
     #[serde(default = "default_refine")]
     pub refine: Vec<f64>,
+    /// Runs of each measurement (default 1); the report keeps the fastest, since a
+    /// shared machine only ever slows a run down.
+    #[serde(default = "default_repeats")]
+    pub repeats: usize,
+}
+
+fn default_repeats() -> usize {
+    1
 }
 
 fn default_refine() -> Vec<f64> {
@@ -258,6 +266,12 @@ impl Matrix {
                 return Err(bad(
                     format!("{}.threads", s.common.name),
                     "needs thread counts ≥ 1",
+                ));
+            }
+            if s.repeats == 0 {
+                return Err(bad(
+                    format!("{}.repeats", s.common.name),
+                    "needs at least one run",
                 ));
             }
         }

@@ -43,6 +43,8 @@ pub struct Record {
     pub y: String,
     /// Worker threads.
     pub threads: usize,
+    /// Repetition of a throughput measurement (0: the first).
+    pub repeat: usize,
     /// `completed`, `failed`, `interrupted`, or `no-summary` when the run wrote none.
     pub status: String,
     /// `completed`, `energy-growth` or `failed` (stability maps read this).
@@ -162,6 +164,7 @@ impl Record {
             x,
             y,
             threads: case.threads,
+            repeat: case.repeat,
             status,
             outcome: outcome.into(),
             failure_kind,
