@@ -718,9 +718,10 @@ pub struct BoundarySpec {
 pub enum Imposed {
     /// Every kernel node inside the region is at rest (a staircase of whole cells).
     Nodes,
-    /// The region's nodes take the velocities under which the velocity interpolated at
-    /// the particles inside the region vanishes, in the mass-weighted least-squares
-    /// sense (`umls_engine::FittedClamp`): the clamp ends where those particles end.
+    /// The region's nodes take the velocities under which the particles inside the
+    /// region neither move nor deform (velocity and velocity gradient zero there), in the
+    /// mass-weighted least-squares sense (`umls_engine::FittedClamp`): the clamp ends
+    /// where those particles end.
     Fit,
 }
 

@@ -96,8 +96,8 @@ pub struct Boundary<const D: usize> {
     /// user wants to read; a node in two sets counts in both). See
     /// [`crate::Simulation::reactions`].
     pub reaction_sets: Vec<Vec<u32>>,
-    /// Clamps imposed on the fit: their nodes take the velocities under which the
-    /// velocity at their particles vanishes ([`FittedClamp`]).
+    /// Clamps imposed on the fit: their nodes take the velocities under which their
+    /// particles neither move nor deform, in the least-squares sense ([`FittedClamp`]).
     pub fitted: Vec<FittedClamp>,
 }
 

@@ -48,8 +48,8 @@ pub(crate) struct ClampRow<const D: usize> {
 }
 
 impl FittedClamp {
-    /// A clamp whose `nodes` are fitted so that the velocity vanishes at `particles`
-    /// (indices into the simulation's particles). Repeated indices are merged.
+    /// A clamp whose `nodes` are fitted so that `particles` (indices into the
+    /// simulation's particles) neither move nor deform. Repeated indices are merged.
     pub fn new(mut nodes: Vec<u32>, mut particles: Vec<u32>) -> Self {
         nodes.sort_unstable();
         nodes.dedup();
@@ -67,7 +67,7 @@ impl FittedClamp {
         &self.nodes
     }
 
-    /// The particles at which the velocity is made to vanish.
+    /// The particles held at rest.
     pub fn particles(&self) -> &[u32] {
         &self.particles
     }
