@@ -36,6 +36,7 @@ use nalgebra::SVector;
 use rayon::prelude::*;
 
 use crate::boundary::Boundary;
+use crate::scatter::NODE_CHUNK;
 use crate::settings::Damping;
 
 /// Nodal fields of one step.
@@ -56,6 +57,13 @@ pub(crate) struct Grid<const D: usize> {
     /// ṽ_i = v_i + Δt f_i / m_i (Δt f_i / Δt² k_i on mass-scaled nodes), plus the
     /// redistributed impulse, with boundary conditions.
     pub new_velocity: Vec<SVector<f64, D>>,
+    /// Per chunk of [`NODE_CHUNK`] nodes: whether it may hold non-zero values this step.
+    /// The others hold zeros in every field (every writer leaves a node without mass at
+    /// zero), so P2G's merge and the grid update skip them: a body in a large box of
+    /// empty nodes does not pay for the box.
+    pub live: Vec<bool>,
+    /// Per chunk: whether the last P2G reached it.
+    pub touched: Vec<bool>,
     /// Contributions below this mass are round-off (10⁻¹² of the heaviest particle).
     pub round_off_mass: f64,
 }
@@ -143,6 +151,8 @@ impl<const D: usize> Grid<D> {
             + bytes(&self.stiffness)
             + bytes(&self.velocity)
             + bytes(&self.new_velocity)
+            + bytes(&self.live)
+            + bytes(&self.touched)
     }
 
     /// Arrays for `nodes` nodes.
@@ -156,6 +166,8 @@ impl<const D: usize> Grid<D> {
             stiffness: vec![0.0; nodes],
             velocity: vec![SVector::zeros(); nodes],
             new_velocity: vec![SVector::zeros(); nodes],
+            live: vec![false; nodes.div_ceil(NODE_CHUNK)],
+            touched: vec![false; nodes.div_ceil(NODE_CHUNK)],
         }
     }
 
@@ -219,11 +231,17 @@ impl<const D: usize> Grid<D> {
             .zip(self.stiffness.par_chunks(UPDATE_CHUNK))
             .zip(self.velocity.par_chunks_mut(UPDATE_CHUNK))
             .zip(self.new_velocity.par_chunks_mut(UPDATE_CHUNK))
+            .zip(self.live.par_iter())
             .map(
-                |((((((mass, abs_mass), momentum), force), stiffness), velocity), new_velocity)| {
+                |(
+                    ((((((mass, abs_mass), momentum), force), stiffness), velocity), new_velocity),
+                    &live,
+                )| {
                     let (mut dropped, mut redistributed, mut scaled, mut active) =
                         (0.0, SVector::<f64, D>::zeros(), 0usize, 0.0);
-                    for i in 0..mass.len() {
+                    // A chunk no particle reached, now or in the last step, is zero.
+                    let nodes = if live { mass.len() } else { 0 };
+                    for i in 0..nodes {
                         let m = mass[i];
                         if !active_node(m, abs_mass[i], round_off, cancellation_fraction) {
                             // A node with no mass at all can still carry a force (N = 0,
@@ -292,7 +310,7 @@ impl<const D: usize> Grid<D> {
 
 /// Nodes per parallel work item of the grid update (fixed, so that the partial sums, and
 /// hence the report, do not depend on the thread count).
-const UPDATE_CHUNK: usize = 4096;
+const UPDATE_CHUNK: usize = NODE_CHUNK;
 
 /// Whether a node with mass `m` and Σ|N| m_p = `abs_mass` carries velocity: above the
 /// round-off mass, and not mostly cancelled by negative MLS values.

@@ -26,7 +26,7 @@ pub(crate) const BLOCK: usize = 4096;
 const MAX_SPAN: usize = 4;
 
 /// Nodes per parallel work item of the merge.
-const MERGE_CHUNK: usize = 4096;
+const MERGE_CHUNK: usize = NODE_CHUNK;
 
 /// One node's sums in a window, kept together so that a stencil entry's contribution
 /// touches one place in memory rather than five arrays.
@@ -94,7 +94,17 @@ pub(crate) struct NodalSums<'a, const D: usize> {
     pub stiffness: &'a mut [f64],
     pub momentum: &'a mut [SVector<f64, D>],
     pub force: &'a mut [SVector<f64, D>],
+    /// Per chunk of [`NODE_CHUNK`] nodes: whether it may hold non-zero values this step
+    /// (a block's window reaches it now, or reached it in the last step, whose values
+    /// must be cleared). Written by [`Scatter::scatter`].
+    pub live: &'a mut [bool],
+    /// Per chunk: whether the last scatter's windows reached it.
+    pub touched: &'a mut [bool],
 }
+
+/// Nodes per chunk of the merge and of the grid update (fixed, so that sums taken per
+/// chunk do not depend on the thread count).
+pub(crate) const NODE_CHUNK: usize = 4096;
 
 /// The particle order, the blocks and their windows, reused from step to step.
 #[derive(Debug, Clone, Default)]
@@ -106,6 +116,8 @@ pub(crate) struct Scatter<const D: usize> {
     /// The node range `lo..hi` each block touches.
     ranges: Vec<(usize, usize)>,
     windows: Vec<Window<D>>,
+    /// Chunks of nodes the current windows reach (scratch of [`Self::scatter`]).
+    reached: Vec<bool>,
 }
 
 impl<const D: usize> Scatter<D> {
@@ -162,8 +174,9 @@ impl<const D: usize> Scatter<D> {
     }
 
     /// Scatters the particles through `contribute(block, window)`, where `block` lists
-    /// one block's particles in order, and sums the windows into `sums` (every node
-    /// written; nodes no particle touches get zero). `ranges` holds each particle's
+    /// one block's particles in order, and sums the windows into `sums` (every node of a
+    /// live chunk written, nodes no particle touches with zero; chunks neither reached
+    /// now nor in the last step are zero already and are skipped). `ranges` holds each particle's
     /// lowest and highest stencil node. Among failing blocks the lowest particle index
     /// wins, whatever the thread count; on failure `sums` is left as it was.
     pub fn scatter<F, E>(
@@ -190,6 +203,25 @@ impl<const D: usize> Scatter<D> {
                 contribute(&order[bounds[b]..bounds[b + 1]], window)
             })
             .reduce(|| Ok(()), |a, b| lowest_failure(a, b, |(), ()| ()))?;
+        // Chunks reached now, and those that must be cleared of the last step's values.
+        let chunks = sums.live.len();
+        self.reached.clear();
+        self.reached.resize(chunks, false);
+        for &(lo, hi) in block_ranges.iter().filter(|(lo, hi)| hi > lo) {
+            for c in lo / NODE_CHUNK..=(hi - 1) / NODE_CHUNK {
+                self.reached[c] = true;
+            }
+        }
+        for ((live, touched), &now) in sums
+            .live
+            .iter_mut()
+            .zip(sums.touched.iter_mut())
+            .zip(&self.reached)
+        {
+            *live = now || *touched;
+            *touched = now;
+        }
+        let live: &[bool] = sums.live;
         let windows = &self.windows[..blocks];
         sums.mass
             .par_chunks_mut(MERGE_CHUNK)
@@ -199,6 +231,9 @@ impl<const D: usize> Scatter<D> {
             .zip(sums.force.par_chunks_mut(MERGE_CHUNK))
             .enumerate()
             .for_each(|(c, ((((mass, abs_mass), stiffness), momentum), force))| {
+                if !live[c] {
+                    return;
+                }
                 mass.fill(0.0);
                 abs_mass.fill(0.0);
                 stiffness.fill(0.0);
