@@ -22,10 +22,10 @@
 //! [`FITTED_CLAMP_REGULARISATION`]) only keeps the normal matrix regular.
 //!
 //! The normal matrix is dense over the clamp nodes the clamped particles reach and is
-//! factorised every step (twice: for v and ṽ), so the cost grows with the cube of that
+//! factorised once a step (v, ṽ and the MUSL re-map share it), so the cost grows with the cube of that
 //! count: meant for clamps of up to a few thousand nodes (the cantilever's has 50–150).
 
-use nalgebra::{DMatrix, DVector, SVector};
+use nalgebra::{Cholesky, DMatrix, DVector, Dyn, SVector};
 
 /// Relative weight ε of the Tikhonov term that keeps the normal matrix regular.
 pub const FITTED_CLAMP_REGULARISATION: f64 = 1e-6;
@@ -72,17 +72,10 @@ impl FittedClamp {
         &self.particles
     }
 
-    /// Fits the clamp's nodes of `velocity` to the clamped particles' stencils `rows`:
-    /// nodes the rows do not reach are set to rest, the others to the regularised
-    /// least-squares solution given the other nodes' velocities.
-    pub(crate) fn fit<const D: usize>(
-        &self,
-        rows: &[ClampRow<D>],
-        velocity: &mut [SVector<f64, D>],
-    ) {
-        for &n in &self.nodes {
-            velocity[n as usize] = SVector::zeros();
-        }
+    /// The least-squares system of this step's clamped-particle stencils `rows`: the
+    /// unknowns (the clamp's nodes the rows reach) and the factorised normal matrix,
+    /// which every velocity field of the step shares ([`Self::fit`]).
+    pub(crate) fn system<const D: usize>(&self, rows: Vec<ClampRow<D>>) -> ClampSystem<D> {
         // Unknowns: the clamp's nodes the rows reach, numbered in node order.
         let mut unknowns: Vec<u32> = rows
             .iter()
@@ -92,49 +85,62 @@ impl FittedClamp {
         unknowns.sort_unstable();
         unknowns.dedup();
         let k = unknowns.len();
-        if k == 0 {
-            return;
-        }
-        let index = |n: u32| unknowns.binary_search(&n).ok();
         let mut normal = DMatrix::<f64>::zeros(k, k);
-        let mut rhs = vec![DVector::<f64>::zeros(k); D];
         let mut local: Vec<(usize, f64)> = Vec::new();
-        // One least-squares row Σ_i c_i v_i = 0 over a particle's nodes, weighted by
-        // `weight`: the clamp's nodes are unknown, the free nodes' part is the target.
-        let mut add_row = |weight: f64, coefficients: &mut dyn Iterator<Item = (u32, f64)>| {
+        self.for_each_row(&rows, |weight, coefficients| {
+            local.clear();
+            local.extend(coefficients.filter_map(|(n, c)| Some((index(&unknowns, n)?, c))));
+            for &(a, ca) in &local {
+                for &(b, cb) in &local {
+                    normal[(a, b)] += weight * ca * cb;
+                }
+            }
+        });
+        let scale = (0..k).map(|j| normal[(j, j)]).fold(0.0, f64::max);
+        for j in 0..k {
+            normal[(j, j)] += FITTED_CLAMP_REGULARISATION * scale;
+        }
+        let cholesky = if k == 0 { None } else { normal.cholesky() };
+        ClampSystem {
+            rows,
+            unknowns,
+            cholesky,
+        }
+    }
+
+    /// Fits the clamp's nodes of `velocity` with the step's `system`: nodes the rows do
+    /// not reach are set to rest, the others to the regularised least-squares solution
+    /// given the other nodes' velocities.
+    pub(crate) fn fit<const D: usize>(
+        &self,
+        system: &ClampSystem<D>,
+        velocity: &mut [SVector<f64, D>],
+    ) {
+        for &n in &self.nodes {
+            velocity[n as usize] = SVector::zeros();
+        }
+        let Some(cholesky) = &system.cholesky else {
+            return;
+        };
+        let unknowns = &system.unknowns;
+        let mut rhs = vec![DVector::<f64>::zeros(unknowns.len()); D];
+        let mut local: Vec<(usize, f64)> = Vec::new();
+        // The clamp's nodes are unknown; the free nodes' part of each row is the target.
+        self.for_each_row(&system.rows, |weight, coefficients| {
             let mut target = SVector::<f64, D>::zeros();
             local.clear();
             for (n, c) in coefficients {
-                match index(n) {
+                match index(unknowns, n) {
                     Some(j) => local.push((j, c)),
                     None => target -= velocity[n as usize] * c,
                 }
             }
             for &(a, ca) in &local {
-                for &(b, cb) in &local {
-                    normal[(a, b)] += weight * ca * cb;
-                }
                 for (d, r) in rhs.iter_mut().enumerate() {
                     r[a] += weight * ca * target[d];
                 }
             }
-        };
-        for row in rows {
-            add_row(row.mass, &mut row.entries.iter().map(|e| (e.0, e.1)));
-            for d in 0..D {
-                add_row(
-                    row.mass,
-                    &mut row.entries.iter().map(|e| (e.0, e.2[d] * self.reach)),
-                );
-            }
-        }
-        let scale = (0..k).map(|j| normal[(j, j)]).fold(0.0, f64::max);
-        for j in 0..k {
-            normal[(j, j)] += FITTED_CLAMP_REGULARISATION * scale;
-        }
-        let Some(cholesky) = normal.cholesky() else {
-            return;
-        };
+        });
         for (d, r) in rhs.into_iter().enumerate() {
             let x = cholesky.solve(&r);
             for (j, &n) in unknowns.iter().enumerate() {
@@ -142,4 +148,39 @@ impl FittedClamp {
             }
         }
     }
+
+    /// Calls `f(weight, coefficients)` for every scalar least-squares row Σ_i c_i v_i = 0:
+    /// per clamped particle its velocity (c_i = N_ip) and each component of its velocity
+    /// gradient (c_i = ℓ ∂_d N_ip), weighted by its mass.
+    fn for_each_row<const D: usize>(
+        &self,
+        rows: &[ClampRow<D>],
+        mut f: impl FnMut(f64, &mut dyn Iterator<Item = (u32, f64)>),
+    ) {
+        for row in rows {
+            f(row.mass, &mut row.entries.iter().map(|e| (e.0, e.1)));
+            for d in 0..D {
+                f(
+                    row.mass,
+                    &mut row.entries.iter().map(|e| (e.0, e.2[d] * self.reach)),
+                );
+            }
+        }
+    }
+}
+
+/// One step's least-squares system of a [`FittedClamp`]: built once
+/// ([`FittedClamp::system`]) and applied to v, ṽ and, under MUSL, the re-mapped velocity.
+pub(crate) struct ClampSystem<const D: usize> {
+    rows: Vec<ClampRow<D>>,
+    /// The clamp's nodes the rows reach, sorted.
+    unknowns: Vec<u32>,
+    /// The factorised normal matrix (`None` with no unknowns or a failed factorisation,
+    /// when the clamp's nodes are simply at rest).
+    cholesky: Option<Cholesky<f64, Dyn>>,
+}
+
+/// The position of node `n` among the sorted `unknowns`.
+fn index(unknowns: &[u32], n: u32) -> Option<usize> {
+    unknowns.binary_search(&n).ok()
 }

@@ -65,6 +65,8 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
         Vec<crate::boundary::Reaction<D>>,
     ),
     velocity_gradients: Vec<SMatrix<f64, D, D>>,
+    /// This step's least-squares systems of the boundary's fitted clamps.
+    clamp_systems: Vec<crate::fitted_clamp::ClampSystem<D>>,
 }
 
 /// Checks a number setting.
@@ -184,6 +186,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             stresses_current: false,
             reactions: Default::default(),
             velocity_gradients: Vec::new(),
+            clamp_systems: Vec::new(),
             grid,
         })
     }

@@ -12,18 +12,23 @@ use crate::fitted_clamp::ClampRow;
 use crate::transfer::TransferScheme;
 
 impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
-    /// Fits the clamps' nodes in the grid velocities before and after the update (so a
-    /// FLIP increment vanishes at the clamped particles as well as the velocity).
+    /// Builds this step's clamp systems (kept for the MUSL re-map) and fits the clamps'
+    /// nodes in the grid velocities before and after the update (so a FLIP increment
+    /// vanishes at the clamped particles as well as the velocity).
     pub(super) fn apply_fitted_clamps(&mut self) -> Result<(), EngineError> {
-        for (clamp, rows) in self.boundary.fitted.iter().zip(self.fitted_clamp_rows()?) {
-            clamp.fit(&rows, &mut self.grid.velocity);
-            clamp.fit(&rows, &mut self.grid.new_velocity);
+        let rows = self.fitted_clamp_rows()?;
+        self.clamp_systems.clear();
+        for (clamp, rows) in self.boundary.fitted.iter().zip(rows) {
+            let system = clamp.system(rows);
+            clamp.fit(&system, &mut self.grid.velocity);
+            clamp.fit(&system, &mut self.grid.new_velocity);
+            self.clamp_systems.push(system);
         }
         Ok(())
     }
 
     /// The clamped particles' stencils of this step, one list per clamp.
-    pub(super) fn fitted_clamp_rows(&self) -> Result<Vec<Vec<ClampRow<D>>>, EngineError> {
+    fn fitted_clamp_rows(&self) -> Result<Vec<Vec<ClampRow<D>>>, EngineError> {
         let step = self.step;
         let (p, kernel, stencils) = (&self.particles, &self.kernel, &self.stencils);
         let mut scratch = Stencil::new();

@@ -44,12 +44,11 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             };
         }
         self.boundary.apply(&mut g.velocity);
-        let rows = self.fitted_clamp_rows()?;
-        let g = &mut self.grid;
-        for (clamp, rows) in self.boundary.fitted.iter().zip(&rows) {
-            clamp.fit(rows, &mut g.velocity);
+        // The re-map reads the start-of-step stencils, as the grid update's clamp
+        // systems did: the same systems serve.
+        for (clamp, system) in self.boundary.fitted.iter().zip(&self.clamp_systems) {
+            clamp.fit(system, &mut g.velocity);
         }
-        let (p, kernel, stencils) = (&self.particles, &self.kernel, &self.stencils);
         let v = &g.velocity;
         self.velocity_gradients
             .par_iter_mut()
