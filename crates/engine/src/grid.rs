@@ -62,8 +62,6 @@ pub(crate) struct Grid<const D: usize> {
     /// zero), so P2G's merge and the grid update skip them: a body in a large box of
     /// empty nodes does not pay for the box.
     pub live: Vec<bool>,
-    /// Per chunk: whether the last P2G reached it.
-    pub touched: Vec<bool>,
     /// Contributions below this mass are round-off (10⁻¹² of the heaviest particle).
     pub round_off_mass: f64,
 }
@@ -152,7 +150,6 @@ impl<const D: usize> Grid<D> {
             + bytes(&self.velocity)
             + bytes(&self.new_velocity)
             + bytes(&self.live)
-            + bytes(&self.touched)
     }
 
     /// Arrays for `nodes` nodes.
@@ -167,7 +164,6 @@ impl<const D: usize> Grid<D> {
             velocity: vec![SVector::zeros(); nodes],
             new_velocity: vec![SVector::zeros(); nodes],
             live: vec![false; nodes.div_ceil(NODE_CHUNK)],
-            touched: vec![false; nodes.div_ceil(NODE_CHUNK)],
         }
     }
 
@@ -211,7 +207,7 @@ impl<const D: usize> Grid<D> {
             self.velocity
                 .par_iter_mut()
                 .zip(self.mass.par_iter().zip(self.momentum.par_iter()))
-                .with_min_len(UPDATE_CHUNK)
+                .with_min_len(NODE_CHUNK)
                 .for_each(|(v, (&m, p))| {
                     *v = if m != 0.0 { p / m } else { SVector::zeros() };
                 });
@@ -224,13 +220,13 @@ impl<const D: usize> Grid<D> {
         let local_damping = matches!(damping, Damping::Local { .. });
         let partials: Vec<(f64, SVector<f64, D>, usize, f64)> = self
             .mass
-            .par_chunks(UPDATE_CHUNK)
-            .zip(self.abs_mass.par_chunks(UPDATE_CHUNK))
-            .zip(self.momentum.par_chunks(UPDATE_CHUNK))
-            .zip(self.force.par_chunks(UPDATE_CHUNK))
-            .zip(self.stiffness.par_chunks(UPDATE_CHUNK))
-            .zip(self.velocity.par_chunks_mut(UPDATE_CHUNK))
-            .zip(self.new_velocity.par_chunks_mut(UPDATE_CHUNK))
+            .par_chunks(NODE_CHUNK)
+            .zip(self.abs_mass.par_chunks(NODE_CHUNK))
+            .zip(self.momentum.par_chunks(NODE_CHUNK))
+            .zip(self.force.par_chunks(NODE_CHUNK))
+            .zip(self.stiffness.par_chunks(NODE_CHUNK))
+            .zip(self.velocity.par_chunks_mut(NODE_CHUNK))
+            .zip(self.new_velocity.par_chunks_mut(NODE_CHUNK))
             .zip(self.live.par_iter())
             .map(
                 |(
@@ -292,7 +288,7 @@ impl<const D: usize> Grid<D> {
             self.new_velocity
                 .par_iter_mut()
                 .enumerate()
-                .with_min_len(UPDATE_CHUNK)
+                .with_min_len(NODE_CHUNK)
                 .for_each(|(i, v)| {
                     if active_node(mass[i], abs_mass[i], round_off, cancellation_fraction) {
                         *v += shift;
@@ -307,10 +303,6 @@ impl<const D: usize> Grid<D> {
         report
     }
 }
-
-/// Nodes per parallel work item of the grid update (fixed, so that the partial sums, and
-/// hence the report, do not depend on the thread count).
-const UPDATE_CHUNK: usize = NODE_CHUNK;
 
 /// Whether a node with mass `m` and Σ|N| m_p = `abs_mass` carries velocity: above the
 /// round-off mass, and not mostly cancelled by negative MLS values.

@@ -25,9 +25,6 @@ pub(crate) const BLOCK: usize = 4096;
 /// The windows may span together at most this many times the node count.
 const MAX_SPAN: usize = 4;
 
-/// Nodes per parallel work item of the merge.
-const MERGE_CHUNK: usize = NODE_CHUNK;
-
 /// One node's sums in a window, kept together so that a stencil entry's contribution
 /// touches one place in memory rather than five arrays.
 #[derive(Debug, Clone, Copy)]
@@ -98,8 +95,6 @@ pub(crate) struct NodalSums<'a, const D: usize> {
     /// (a block's window reaches it now, or reached it in the last step, whose values
     /// must be cleared). Written by [`Scatter::scatter`].
     pub live: &'a mut [bool],
-    /// Per chunk: whether the last scatter's windows reached it.
-    pub touched: &'a mut [bool],
 }
 
 /// Nodes per chunk of the merge and of the grid update (fixed, so that sums taken per
@@ -116,7 +111,7 @@ pub(crate) struct Scatter<const D: usize> {
     /// The node range `lo..hi` each block touches.
     ranges: Vec<(usize, usize)>,
     windows: Vec<Window<D>>,
-    /// Chunks of nodes the current windows reach (scratch of [`Self::scatter`]).
+    /// Chunks of [`NODE_CHUNK`] nodes the last scatter's windows reached.
     reached: Vec<bool>,
 }
 
@@ -128,7 +123,11 @@ impl<const D: usize> Scatter<D> {
         let windows: usize = self.windows.iter().map(|w| bytes(&w.sums)).sum();
         (
             bytes(&self.keys) + bytes(&self.order),
-            windows + bytes(&self.windows) + bytes(&self.bounds) + bytes(&self.ranges),
+            windows
+                + bytes(&self.windows)
+                + bytes(&self.bounds)
+                + bytes(&self.ranges)
+                + bytes(&self.reached),
         )
     }
 
@@ -203,32 +202,25 @@ impl<const D: usize> Scatter<D> {
                 contribute(&order[bounds[b]..bounds[b + 1]], window)
             })
             .reduce(|| Ok(()), |a, b| lowest_failure(a, b, |(), ()| ()))?;
-        // Chunks reached now, and those that must be cleared of the last step's values.
-        let chunks = sums.live.len();
-        self.reached.clear();
-        self.reached.resize(chunks, false);
+        // Live: the chunks reached now, and those reached last time, whose values must
+        // be cleared.
+        self.reached.resize(sums.live.len(), false);
+        sums.live.copy_from_slice(&self.reached);
+        self.reached.fill(false);
         for &(lo, hi) in block_ranges.iter().filter(|(lo, hi)| hi > lo) {
             for c in lo / NODE_CHUNK..=(hi - 1) / NODE_CHUNK {
                 self.reached[c] = true;
+                sums.live[c] = true;
             }
-        }
-        for ((live, touched), &now) in sums
-            .live
-            .iter_mut()
-            .zip(sums.touched.iter_mut())
-            .zip(&self.reached)
-        {
-            *live = now || *touched;
-            *touched = now;
         }
         let live: &[bool] = sums.live;
         let windows = &self.windows[..blocks];
         sums.mass
-            .par_chunks_mut(MERGE_CHUNK)
-            .zip(sums.abs_mass.par_chunks_mut(MERGE_CHUNK))
-            .zip(sums.stiffness.par_chunks_mut(MERGE_CHUNK))
-            .zip(sums.momentum.par_chunks_mut(MERGE_CHUNK))
-            .zip(sums.force.par_chunks_mut(MERGE_CHUNK))
+            .par_chunks_mut(NODE_CHUNK)
+            .zip(sums.abs_mass.par_chunks_mut(NODE_CHUNK))
+            .zip(sums.stiffness.par_chunks_mut(NODE_CHUNK))
+            .zip(sums.momentum.par_chunks_mut(NODE_CHUNK))
+            .zip(sums.force.par_chunks_mut(NODE_CHUNK))
             .enumerate()
             .for_each(|(c, ((((mass, abs_mass), stiffness), momentum), force))| {
                 if !live[c] {
@@ -239,7 +231,7 @@ impl<const D: usize> Scatter<D> {
                 stiffness.fill(0.0);
                 momentum.fill(SVector::zeros());
                 force.fill(SVector::zeros());
-                let start = c * MERGE_CHUNK;
+                let start = c * NODE_CHUNK;
                 let end = start + mass.len();
                 // In block order, so each node's sum has the same order on any threads.
                 for w in windows {
