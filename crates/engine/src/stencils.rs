@@ -63,6 +63,13 @@ impl<const D: usize> ParticleStencil<'_, D> {
     }
 }
 
+/// What a transfer does with one stencil entry ([`Stencils::visit`]); implementors
+/// mark `entry` `#[inline(always)]`, it runs 9 to 64 times per particle.
+pub(crate) trait EntrySink<const D: usize> {
+    /// Node `node` with N, ∇N and the offset x_node − x_p.
+    fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, offset: &SVector<f64, D>);
+}
+
 /// The stencils of all particles (stored by chunk, or to be recomputed) and their node
 /// ranges.
 #[derive(Debug, Clone, Default)]
@@ -151,6 +158,48 @@ impl<const D: usize> Stencils<D> {
     /// The smallest and largest node of each particle's stencil.
     pub fn ranges(&self) -> &[(u32, u32)] {
         &self.ranges
+    }
+
+    /// Hands every entry of particle `p`'s stencil to `sink`: the stored one, or the
+    /// kernel's [`Kernel::visit_stencil`] at `x` from `cache` (same entries, same bits,
+    /// and for a closed-form kernel no arrays written and read back). Stored stencils
+    /// have no offsets: with `offsets` they are recomputed from the node positions,
+    /// without it zeros are passed.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn visit<K: Kernel<D>, S: EntrySink<D>>(
+        &self,
+        p: usize,
+        kernel: &K,
+        x: &SVector<f64, D>,
+        cache: &K::Cache,
+        scratch: &mut Stencil<D>,
+        offsets: bool,
+        sink: &mut S,
+    ) -> Result<(), (usize, KernelError)> {
+        if self.stored {
+            let chunk = &self.chunks[p / CHUNK];
+            let k = p % CHUNK;
+            let range = chunk.offsets[k]..chunk.offsets[k + 1];
+            for e in range {
+                let node = chunk.nodes[e];
+                let offset = if offsets {
+                    kernel.node_position(node as usize) - x
+                } else {
+                    SVector::zeros()
+                };
+                sink.entry(node, chunk.values[e], &chunk.gradients[e], &offset);
+            }
+            return Ok(());
+        }
+        let mut cache = *cache;
+        // A closure with this one call site, so the kernel's loop inlines it (a closure
+        // called from two places stays a call, and its sums leave the registers).
+        kernel
+            .visit_stencil(x, &mut cache, scratch, |node, n, gradient, offset| {
+                sink.entry(node, n, gradient, offset)
+            })
+            .map_err(|e| (p, e))
     }
 
     /// Calls `f` with particle `p`'s stencil: the stored one, or evaluated into `scratch`

@@ -233,10 +233,46 @@ impl<const D: usize> Kernel<D> for BSplineKernel<D> {
         _: &mut (),
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError> {
-        let width = self.order.width();
+        let count = self.order.width().pow(D as u32);
+        let entries = out.entries_mut(count);
+        let mut e = 0;
+        self.entries(x, |node, value, gradient, offset| {
+            entries.nodes[e] = node;
+            entries.values[e] = value;
+            entries.gradients[e] = *gradient;
+            entries.offsets[e] = *offset;
+            e += 1;
+        })
+    }
+
+    #[inline(always)]
+    fn visit_stencil<F>(
+        &self,
+        x: &SVector<f64, D>,
+        _: &mut (),
+        _: &mut Stencil<D>,
+        visit: F,
+    ) -> Result<(), KernelError>
+    where
+        F: FnMut(u32, f64, &SVector<f64, D>, &SVector<f64, D>),
+    {
+        self.entries(x, visit)
+    }
+}
+
+impl<const D: usize> BSplineKernel<D> {
+    /// The stencil at `x`, entry by entry: `visit(node, N, ∇N, x_node − x)` with nodes
+    /// in index order (rows along axis 0, the numbering's fastest axis). One body for
+    /// [`Kernel::stencil`] and [`Kernel::visit_stencil`], so both give the same bits.
+    #[inline(always)]
+    fn entries<F>(&self, x: &SVector<f64, D>, mut visit: F) -> Result<(), KernelError>
+    where
+        F: FnMut(u32, f64, &SVector<f64, D>, &SVector<f64, D>),
+    {
         let base = self.base_nodes(x)?;
         // Per axis: weights, derivatives and offsets x_i − x of the `width` nodes. The
         // offset is computed as node_position(i) − x would be, so both agree bit for bit.
+        let width = self.order.width();
         let mut w = [[0.0; 4]; D];
         let mut dw = [[0.0; 4]; D];
         let mut r = [[0.0; 4]; D];
@@ -252,13 +288,9 @@ impl<const D: usize> Kernel<D> for BSplineKernel<D> {
         }
         let strides = self.strides();
         let first = self.node_index(base);
-        let count = width.pow(D as u32);
-        let entries = out.entries_mut(count);
-        // Rows along axis 0 (the node numbering's fastest axis), written in place. The
-        // factors are multiplied in axis order, as N = Π_k w_k reads (regrouping them
-        // would change the last bit of the results).
+        // The factors are multiplied in axis order, as N = Π_k w_k reads (regrouping
+        // them would change the last bit of the results).
         let mut digits = [0usize; D];
-        let mut e = 0;
         loop {
             let mut node = first;
             for k in 1..D {
@@ -269,9 +301,7 @@ impl<const D: usize> Kernel<D> for BSplineKernel<D> {
                 for k in 1..D {
                     value *= w[k][digits[k]];
                 }
-                entries.values[e] = value;
-                entries.nodes[e] = (node + a) as u32;
-                entries.gradients[e] = SVector::<f64, D>::from_fn(|j, _| {
+                let gradient = SVector::<f64, D>::from_fn(|j, _| {
                     let mut g = if j == 0 { dw[0][a] } else { w[0][a] };
                     for k in 1..D {
                         g *= if k == j {
@@ -282,13 +312,13 @@ impl<const D: usize> Kernel<D> for BSplineKernel<D> {
                     }
                     g
                 });
-                entries.offsets[e] =
+                let offset =
                     SVector::<f64, D>::from_fn(
                         |k, _| {
                             if k == 0 { r[0][a] } else { r[k][digits[k]] }
                         },
                     );
-                e += 1;
+                visit((node + a) as u32, value, &gradient, &offset);
             }
             // The next row: an odometer over axes 1..D.
             let mut k = 1;

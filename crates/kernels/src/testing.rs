@@ -9,6 +9,7 @@
 //! - offsets x_i − x that match the node positions, and a `Kernel::node_range` equal
 //!   to the stencil's smallest and largest node;
 //! - the same stencil from a fresh location cache as from a warm one;
+//! - `Kernel::visit_stencil` handing over the stencil's entries in order, bit for bit;
 //! - a typed `KernelError::OutsideDomain` far outside.
 //!
 //! ```
@@ -119,6 +120,17 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
         if st != fresh {
             return Err(fail("a fresh cache gives another stencil".into()));
         }
+        let mut visited = Stencil::new();
+        kernel
+            .visit_stencil(x, &mut K::Cache::default(), &mut fresh, |node, n, g, r| {
+                visited.push(node, n, *g, *r)
+            })
+            .map_err(|e| fail(format!("visit_stencil fails inside the domain: {e}")))?;
+        if st != visited {
+            return Err(fail(
+                "visit_stencil hands over other entries than stencil gives".into(),
+            ));
+        }
     }
     let outside_error = |what: &str, got: String| Violation {
         point: outside.iter().copied().collect(),
@@ -129,7 +141,11 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
         other => return Err(outside_error("stencil", format!("{other:?}"))),
     }
     match kernel.node_range(&outside, &mut K::Cache::default(), &mut st) {
+        Err(KernelError::OutsideDomain { .. }) => {}
+        other => return Err(outside_error("node_range", format!("{other:?}"))),
+    }
+    match kernel.visit_stencil(&outside, &mut K::Cache::default(), &mut st, |_, _, _, _| {}) {
         Err(KernelError::OutsideDomain { .. }) => Ok(()),
-        other => Err(outside_error("node_range", format!("{other:?}"))),
+        other => Err(outside_error("visit_stencil", format!("{other:?}"))),
     }
 }

@@ -200,7 +200,8 @@ fn umls_full_gradient_is_the_derivative_of_the_values() {
 
 /// The suite catches what it checks: hat functions on [0, 1] pass it; scaled values, a
 /// wrong declared second moment, a node beyond the count, and no error outside each fail
-/// it with the property named, as do wrong offsets and a wrong node range.
+/// it with the property named, as do wrong offsets, a wrong node range and a visitor
+/// that hands the entries over in another order.
 #[test]
 fn the_public_suite_catches_broken_kernels() {
     #[derive(Clone, Copy)]
@@ -211,6 +212,7 @@ fn the_public_suite_catches_broken_kernels() {
         rejects_outside: bool,
         offset_scale: f64,
         claimed_range: Option<(u32, u32)>,
+        visits_reversed: bool,
     }
     impl Kernel<1> for Hat {
         type Cache = ();
@@ -234,6 +236,27 @@ fn the_public_suite_catches_broken_kernels() {
         ) -> Result<(u32, u32), umls_transfer::KernelError> {
             self.stencil(x, cache, scratch)?;
             Ok(self.claimed_range.unwrap_or((0, 1)))
+        }
+        fn visit_stencil<F>(
+            &self,
+            x: &SVector<f64, 1>,
+            cache: &mut (),
+            scratch: &mut Stencil<1>,
+            mut visit: F,
+        ) -> Result<(), umls_transfer::KernelError>
+        where
+            F: FnMut(u32, f64, &SVector<f64, 1>, &SVector<f64, 1>),
+        {
+            self.stencil(x, cache, scratch)?;
+            let mut entries: Vec<usize> = (0..scratch.len()).collect();
+            if self.visits_reversed {
+                entries.reverse();
+            }
+            for e in entries {
+                let (node, n, g) = scratch.iter().nth(e).unwrap();
+                visit(node, n, g, &scratch.offsets()[e]);
+            }
+            Ok(())
         }
         fn stencil(
             &self,
@@ -267,6 +290,7 @@ fn the_public_suite_catches_broken_kernels() {
         rejects_outside: true,
         offset_scale: 1.0,
         claimed_range: None,
+        visits_reversed: false,
     };
     let points = [SVector::from([0.25]), SVector::from([0.6])];
     let outside = SVector::from([3.0]);
@@ -308,5 +332,12 @@ fn the_public_suite_catches_broken_kernels() {
             ..good
         })
         .contains("node_range")
+    );
+    assert!(
+        failure(Hat {
+            visits_reversed: true,
+            ..good
+        })
+        .contains("visit_stencil")
     );
 }

@@ -143,6 +143,30 @@ pub trait Kernel<const D: usize>: Send + Sync {
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError>;
 
+    /// Calls `visit(node, N, ∇N, x_node − x)` for every entry of the stencil at `x`, in
+    /// the order and with the values [`Self::stencil`] gives, bit for bit, and fails
+    /// where it fails. The default evaluates [`Self::stencil`] into `scratch` and walks
+    /// it; a kernel with a closed form (a B-spline grid) overrides it to hand each entry
+    /// over as it computes it, so that the transfers neither write nor read back the
+    /// stencil's arrays (a quarter of a 3D B-spline step).
+    fn visit_stencil<F>(
+        &self,
+        x: &SVector<f64, D>,
+        cache: &mut Self::Cache,
+        scratch: &mut Stencil<D>,
+        mut visit: F,
+    ) -> Result<(), KernelError>
+    where
+        F: FnMut(u32, f64, &SVector<f64, D>, &SVector<f64, D>),
+    {
+        self.stencil(x, cache, scratch)?;
+        let offsets = scratch.offsets();
+        for (e, (node, value, gradient)) in scratch.iter().enumerate() {
+            visit(node, value, gradient, &offsets[e]);
+        }
+        Ok(())
+    }
+
     /// The smallest and largest node index of the stencil at `x` (the engine orders
     /// particles by them), failing exactly where [`Self::stencil`] fails. The default
     /// evaluates the stencil into `scratch`; a kernel that knows the range without the

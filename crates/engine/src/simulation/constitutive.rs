@@ -59,43 +59,59 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let p = &mut self.particles;
         let (mass, volume) = (&p.mass, &p.volume);
         self.stress_buffer.resize(p.len(), SMatrix::zeros());
+        // In fixed chunks, each folding its particles in a plain loop (a per-particle
+        // `Result` carried through the parallel reduction cost as much as a fluid's
+        // whole stress update); the chunks' minima and first failures are joined in
+        // chunk order, so the report does not depend on the thread count.
+        let chunk = crate::stencils::CHUNK;
         let result = p
             .deformation
-            .par_iter_mut()
-            .zip(p.state.par_iter_mut())
-            .zip(velocity_gradients.par_iter())
-            .zip(self.stress_buffer.par_iter_mut())
+            .par_chunks_mut(chunk)
+            .zip(p.state.par_chunks_mut(chunk))
+            .zip(velocity_gradients.par_chunks(chunk))
+            .zip(self.stress_buffer.par_chunks_mut(chunk))
             .enumerate()
-            .map(|(i, (((f, state), gv), stress))| {
-                let fail = |e| (i, e);
-                *f = (SMatrix::<f64, D, D>::identity() + gv * dt) * *f;
-                if !f.iter().all(|c| c.is_finite()) {
-                    return Err(fail(EngineError::NonFinite {
-                        step,
-                        field: "deformation gradient",
-                        entity: "particle",
-                        index: i,
-                    }));
+            .map(|(c, (((fs, states), gvs), stresses))| {
+                let mut min_density = f64::INFINITY;
+                for (k, (((f, state), gv), stress)) in fs
+                    .iter_mut()
+                    .zip(states.iter_mut())
+                    .zip(gvs)
+                    .zip(stresses.iter_mut())
+                    .enumerate()
+                {
+                    let i = c * chunk + k;
+                    let fail = |e| (i, e);
+                    *f = (SMatrix::<f64, D, D>::identity() + gv * dt) * *f;
+                    if !f.iter().all(|c| c.is_finite()) {
+                        return Err(fail(EngineError::NonFinite {
+                            step,
+                            field: "deformation gradient",
+                            entity: "particle",
+                            index: i,
+                        }));
+                    }
+                    let det = umls_constitutive::determinant(f);
+                    if det <= 0.0 {
+                        return Err(fail(EngineError::Inverted {
+                            step,
+                            particle: i,
+                            det,
+                        }));
+                    }
+                    *stress = material.return_map_and_stress(f, state).map_err(|source| {
+                        fail(EngineError::Material {
+                            step,
+                            particle: i,
+                            source,
+                        })
+                    })?;
+                    min_density = min_density.min(mass[i] / (volume[i] * det));
                 }
-                let det = umls_constitutive::determinant(f);
-                if det <= 0.0 {
-                    return Err(fail(EngineError::Inverted {
-                        step,
-                        particle: i,
-                        det,
-                    }));
-                }
-                *stress = material.return_map_and_stress(f, state).map_err(|source| {
-                    fail(EngineError::Material {
-                        step,
-                        particle: i,
-                        source,
-                    })
-                })?;
-                Ok(mass[i] / (volume[i] * det))
+                Ok(min_density)
             })
-            // Among failures the lowest particle index wins, so the report does not
-            // depend on the thread count.
+            // Among failures the lowest particle index wins (a chunk stops at its
+            // first), so the report does not depend on the thread count.
             .reduce(|| Ok(f64::INFINITY), |a, b| lowest_failure(a, b, f64::min))
             .map_err(|(_, e)| e);
         // Whole only if every particle got its stress.

@@ -4,13 +4,13 @@
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 use umls_constitutive::Constitutive;
-use umls_transfer::{Kernel, Stencil};
+use umls_transfer::{Kernel, KernelError, Stencil};
 
 use super::Simulation;
 use crate::boundary::Boundary;
 use crate::error::EngineError;
 use crate::parallel::lowest_failure;
-use crate::stencils::ParticleStencil;
+use crate::stencils::{EntrySink, Stencils};
 use crate::transfer::TransferScheme;
 
 /// What G2P computes for one particle.
@@ -30,46 +30,83 @@ struct GridVelocities<'a, const D: usize> {
     new: &'a [SVector<f64, D>],
 }
 
-/// One particle's G2P from its stencil `st` at position `x` with velocity `old`.
+/// A particle's G2P sums over its stencil.
+struct GatherSums<'a, const D: usize, T> {
+    grid: &'a GridVelocities<'a, D>,
+    moment_scale: Option<f64>,
+    offsets: bool,
+    pic: SVector<f64, D>,
+    flip: SVector<f64, D>,
+    grad_v: SMatrix<f64, D, D>,
+    b: SMatrix<f64, D, D>,
+    d: SMatrix<f64, D, D>,
+    transfer: std::marker::PhantomData<T>,
+}
+
+impl<const D: usize, T: TransferScheme> EntrySink<D> for GatherSums<'_, D, T> {
+    #[inline(always)]
+    fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, r: &SVector<f64, D>) {
+        let node = node as usize;
+        let v = self.grid.new[node];
+        self.pic += v * n;
+        if T::USES_FLIP {
+            self.flip += (v - self.grid.old[node]) * n;
+        }
+        self.grad_v += v * gradient.transpose();
+        if self.offsets {
+            if self.moment_scale.is_none() {
+                self.d += r * r.transpose() * n;
+            }
+            if T::USES_MOMENTS {
+                self.b += v * r.transpose() * n;
+            }
+        }
+    }
+}
+
+/// One particle's G2P: particle `p` at position `x` with velocity `old`, its stencil
+/// visited once (recomputed ones without being stored, [`Stencils::visit`]).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
 fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
-    st: &ParticleStencil<'_, D>,
+    stencils: &Stencils<D>,
+    p: usize,
+    cache: &K::Cache,
+    scratch: &mut Stencil<D>,
     kernel: &K,
     transfer: &T,
     grid: &GridVelocities<'_, D>,
     x: SVector<f64, D>,
     old: &SVector<f64, D>,
     dt: f64,
-) -> ParticleUpdate<D> {
+) -> Result<ParticleUpdate<D>, (usize, KernelError)> {
     let moment_scale = kernel.constant_second_moment();
-    let mut pic = SVector::<f64, D>::zeros();
-    let mut flip = SVector::<f64, D>::zeros();
-    let mut grad_v = SMatrix::<f64, D, D>::zeros();
-    let mut b = SMatrix::<f64, D, D>::zeros();
-    let mut d = moment_scale.map_or_else(SMatrix::zeros, |s| SMatrix::identity() * s);
-    for e in 0..st.len() {
-        let node = st.nodes[e] as usize;
-        let n = st.values[e];
-        let v = grid.new[node];
-        pic += v * n;
-        if T::USES_FLIP {
-            flip += (v - grid.old[node]) * n;
-        }
-        grad_v += v * st.gradients[e].transpose();
-        if T::AFFINE && (T::USES_MOMENTS || moment_scale.is_none()) {
-            let r = st.offset(e, kernel, &x);
-            if moment_scale.is_none() {
-                d += r * r.transpose() * n;
-            }
-            if T::USES_MOMENTS {
-                b += v * r.transpose() * n;
-            }
-        }
-    }
+    let offsets = T::AFFINE && (T::USES_MOMENTS || moment_scale.is_none());
+    let mut sums = GatherSums::<D, T> {
+        grid,
+        moment_scale,
+        offsets,
+        pic: SVector::zeros(),
+        flip: SVector::zeros(),
+        grad_v: SMatrix::zeros(),
+        b: SMatrix::zeros(),
+        d: moment_scale.map_or_else(SMatrix::zeros, |s| SMatrix::identity() * s),
+        transfer: std::marker::PhantomData,
+    };
+    stencils.visit(p, kernel, &x, cache, scratch, offsets, &mut sums)?;
+    let GatherSums {
+        pic,
+        flip,
+        grad_v,
+        b,
+        d,
+        ..
+    } = sums;
     let affine = match moment_scale {
         Some(s) => transfer.affine_with_constant_moment(&b, s, &grad_v),
         None => transfer.affine(&b, &d, &grad_v),
     };
-    ParticleUpdate {
+    Ok(ParticleUpdate {
         velocity: transfer.velocity(old, &pic, &flip),
         position: x + pic * dt,
         affine_moment: if T::AFFINE {
@@ -79,7 +116,7 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
         },
         affine,
         velocity_gradient: grad_v,
-    }
+    })
 }
 
 /// One chunk's share of the G2P totals.
@@ -111,9 +148,12 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let (gravity, time, step) = (self.settings.gravity_at(self.time), self.time, self.step);
         let body_force = self.body_force.as_ref();
         let boundary = &self.boundary;
-        let marks = boundary
-            .has_node_conditions()
-            .then(|| boundary.node_marks(self.grid.mass.len()));
+        // The node marks are built at the first particle that leaves the kernel's
+        // domain (mesh kernels at walls given as node sets), not every step: a grid
+        // kernel never asks, and the marks are a pass over every node.
+        let conditions = boundary.has_node_conditions();
+        let nodes = self.grid.mass.len();
+        let marks = std::sync::OnceLock::new();
         let chunk = crate::stencils::CHUNK;
         // In parallel over fixed chunks; each particle's results go straight to the
         // particle arrays, and the partial sums are joined in chunk order.
@@ -142,9 +182,18 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     for k in 0..velocity.len() {
                         let i = c * chunk + k;
                         let x = position[k];
-                        let u = stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
-                            gather(&st, kernel, &transfer, &grid, x, &velocity[k], dt)
-                        })?;
+                        let u = gather(
+                            stencils,
+                            i,
+                            &p.cache[i],
+                            &mut scratch,
+                            kernel,
+                            &transfer,
+                            &grid,
+                            x,
+                            &velocity[k],
+                            dt,
+                        )?;
                         let acceleration = body_force.map_or(gravity, |b| gravity + b(&x, time));
                         power += p.mass[i] * acceleration.dot(&(velocity[k] + u.velocity)) * 0.5;
                         let moved = (u.position - x).norm();
@@ -159,10 +208,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         if boundary.hold(&mut position[k], &mut velocity[k]) {
                             corrections += 1;
                         }
-                        if let Some(marks) = &marks {
+                        if conditions {
                             if let Some(exit) = kernel.domain_exit(&position[k], &p.cache[i]) {
                                 if Boundary::hold_at_facet(
-                                    marks,
+                                    marks.get_or_init(|| boundary.node_marks(nodes)),
                                     &exit,
                                     &mut position[k],
                                     &mut velocity[k],

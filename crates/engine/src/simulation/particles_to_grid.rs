@@ -8,7 +8,8 @@ use umls_transfer::{Kernel, Stencil};
 
 use super::Simulation;
 use crate::error::EngineError;
-use crate::stencils::ParticleStencil;
+use crate::scatter::Window;
+use crate::stencils::{EntrySink, ParticleStencil};
 use crate::transfer::TransferScheme;
 
 /// The affine matrix P2G spreads: C_p, scaled down if its kinetic energy at the
@@ -38,6 +39,39 @@ fn limited_affine<const D: usize, K: Kernel<D>>(
         c * (moment / now).sqrt()
     } else {
         *c
+    }
+}
+
+/// One particle's contributions to the nodes of its stencil.
+struct ScatterEntry<'w, const D: usize, T> {
+    window: &'w mut Window<D>,
+    /// The affine matrix P2G spreads (zero without an affine transfer).
+    affine: SMatrix<f64, D, D>,
+    mass: f64,
+    velocity: SVector<f64, D>,
+    volume: f64,
+    /// Kirchhoff stress times the current volume.
+    stress_volume: SMatrix<f64, D, D>,
+    acceleration: SVector<f64, D>,
+    transfer: std::marker::PhantomData<T>,
+}
+
+impl<const D: usize, T: TransferScheme> EntrySink<D> for ScatterEntry<'_, D, T> {
+    #[inline(always)]
+    fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, r: &SVector<f64, D>) {
+        let m = self.mass;
+        let mut mv = self.velocity;
+        if T::AFFINE {
+            mv += self.affine * r;
+        }
+        self.window.add(
+            node as usize,
+            n * m,
+            n.abs() * m,
+            self.volume * gradient.norm_squared(),
+            mv * (n * m),
+            self.acceleration * (n * m) - self.stress_volume * gradient,
+        );
     }
 }
 
@@ -72,31 +106,40 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     let stress_volume = stresses[i] * volume;
                     let acceleration =
                         gravity + body_force.map_or(SVector::zeros(), |b| b(&x, time));
-                    stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
-                        let c = match (T::AFFINE, varying_moment) {
-                            (false, _) => SMatrix::zeros(),
-                            (true, true) => {
-                                limited_affine(&p.affine[i], p.affine_moment[i], &st, kernel, &x)
+                    let mut sink = ScatterEntry {
+                        window,
+                        affine: SMatrix::zeros(),
+                        mass: m,
+                        velocity: v,
+                        volume,
+                        stress_volume,
+                        acceleration,
+                        transfer: std::marker::PhantomData::<T>,
+                    };
+                    if T::AFFINE && varying_moment {
+                        // The limiter reads the whole stencil before the first entry.
+                        stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
+                            sink.affine =
+                                limited_affine(&p.affine[i], p.affine_moment[i], &st, kernel, &x);
+                            for e in 0..st.len() {
+                                let r = st.offset(e, kernel, &x);
+                                sink.entry(st.nodes[e], st.values[e], &st.gradients[e], &r);
                             }
-                            (true, false) => p.affine[i],
-                        };
-                        for e in 0..st.len() {
-                            let n = st.values[e];
-                            let gradient = st.gradients[e];
-                            let mut mv = v;
-                            if T::AFFINE {
-                                mv += c * st.offset(e, kernel, &x);
-                            }
-                            window.add(
-                                st.nodes[e] as usize,
-                                n * m,
-                                n.abs() * m,
-                                volume * gradient.norm_squared(),
-                                mv * (n * m),
-                                acceleration * (n * m) - stress_volume * gradient,
-                            );
+                        })?;
+                    } else {
+                        if T::AFFINE {
+                            sink.affine = p.affine[i];
                         }
-                    })?;
+                        stencils.visit(
+                            i,
+                            kernel,
+                            &x,
+                            &p.cache[i],
+                            &mut scratch,
+                            T::AFFINE,
+                            &mut sink,
+                        )?;
+                    }
                 }
                 Ok(())
             })
