@@ -13,8 +13,8 @@ use std::time::Instant;
 use nalgebra::{SMatrix, SVector};
 use serde_json::json;
 use umls_engine::{
-    Apic, ApicFlip, Boundary, Diagnostics, EngineError, Flip, Particles, Simulation, StageTimes,
-    StepSettings, TimeStepControl, TransferScheme, VelocityGradientAffine, Wall,
+    Apic, ApicFlip, Boundary, Diagnostics, EngineError, Flip, MlsMpm, Particles, Simulation,
+    StageTimes, StepSettings, TimeStepControl, TransferScheme, VelocityGradientAffine, Wall,
 };
 use umls_io::csv::HistoryWriter;
 use umls_io::vtk::Encoding;
@@ -392,6 +392,16 @@ fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
         TransferKind::VelocityGradient => {
             start(ctx, kernel, table, AffineTransfer::VelocityGradient)
         }
+        TransferKind::MlsMpm => {
+            if kernel.constant_second_moment().is_none() {
+                return Err(ctx.scene.value_error(
+                    "transfer.kind",
+                    "mls-mpm folds the force into the affine term with one constant D_p: \
+                     it needs a B-spline kernel (bspline2, bspline3)",
+                ));
+            }
+            start(ctx, kernel, table, MlsMpm)
+        }
     }
 }
 
@@ -625,6 +635,7 @@ fn transfer_name(spec: &crate::schema::TransferSpec) -> String {
         TransferKind::ApicFlip => format!("apic-flip (alpha {})", spec.alpha),
         TransferKind::Apic => "apic".into(),
         TransferKind::VelocityGradient => "velocity-gradient".into(),
+        TransferKind::MlsMpm => "mls-mpm".into(),
     }
 }
 

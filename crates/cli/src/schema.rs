@@ -335,6 +335,9 @@ pub enum TransferKind {
     ApicFlip,
     /// Affine transfer with C = ∇v.
     VelocityGradient,
+    /// MLS-MPM: APIC with the force folded into the affine momentum and ∇v = C (Hu et
+    /// al. 2018, Taichi's scheme); B-spline kernels only.
+    MlsMpm,
 }
 
 /// `[transfer]`.

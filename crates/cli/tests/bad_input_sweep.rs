@@ -172,6 +172,18 @@ fn bad_command_lines_fail_with_usage() {
             "transfer.alpha",
         ),
         (
+            // MLS-MPM needs a B-spline kernel; the disks run UMLS.
+            vec![
+                "run",
+                "colliding-disks",
+                "--set",
+                "transfer.kind=mls-mpm",
+                "--out",
+                out,
+            ],
+            "transfer.kind",
+        ),
+        (
             vec![
                 "run",
                 "colliding-disks",

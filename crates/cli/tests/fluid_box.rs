@@ -43,6 +43,31 @@ fn fluid_box_falls_freely_at_first_without_a_mesh() {
     assert!(column("momentum_x").abs() < 1e-15 && column("momentum_z").abs() < 1e-15);
 }
 
+/// MLS-MPM folds gravity into the momentum P2G spreads (and the force into the affine
+/// term): in free fall its momentum is still −M g t along y to round-off, and it is
+/// bitwise unchanged by the thread count.
+#[test]
+fn fluid_box_falls_freely_under_mls_mpm_on_any_thread_count() {
+    let scene = runs::variant("fluid-box-3d", &[("kind = \"apic\"", "kind = \"mls-mpm\"")]);
+    let mut histories = Vec::new();
+    for threads in [1, 2] {
+        let mut options = options(&format!("fluid-box-mls-mpm-{threads}"), None, Some(0.005));
+        options.threads = Some(threads);
+        let report = run(&scene, &options).unwrap();
+        assert_eq!(report.summary["transfer"], "mls-mpm", "{}", report.summary);
+        let history = History::read(&options.out);
+        let mass = history.last("mass");
+        let expected = -mass * 9.8 * history.last("time");
+        let momentum = history.last("momentum_y");
+        assert!(
+            (momentum - expected).abs() < 1e-10 * expected.abs(),
+            "{momentum} vs {expected}"
+        );
+        histories.push(std::fs::read_to_string(options.out.join("history.csv")).unwrap());
+    }
+    assert_eq!(histories[0], histories[1]);
+}
+
 /// Without the simplices a grid run seeds the same particles and constrains the same
 /// nodes, upright and turned: the lean background changes only what is built.
 #[test]

@@ -113,12 +113,22 @@ pub enum EngineError {
         /// Valid range.
         reason: &'static str,
     },
+    /// A transfer scheme combined with a kernel or setting it cannot work with.
+    #[error("the {transfer} transfer does not work with {setting}: {reason}")]
+    Unsupported {
+        /// The transfer scheme's name.
+        transfer: &'static str,
+        /// The kernel or setting.
+        setting: &'static str,
+        /// Why.
+        reason: &'static str,
+    },
 }
 
 impl EngineError {
     /// A short name of the kind of failure, for tables and stability maps: `kernel`,
     /// `material`, `non-finite`, `inverted`, `energy-blow-up`, `too-fast`,
-    /// `time-step-too-large`, `initial-stress` or `invalid-parameter`.
+    /// `time-step-too-large`, `initial-stress`, `invalid-parameter` or `unsupported`.
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Kernel { .. } => "kernel",
@@ -130,6 +140,7 @@ impl EngineError {
             Self::TimeStepTooLarge { .. } => "time-step-too-large",
             Self::InitialStress { .. } => "initial-stress",
             Self::InvalidParameter { .. } => "invalid-parameter",
+            Self::Unsupported { .. } => "unsupported",
         }
     }
 }

@@ -295,8 +295,8 @@ impl<const D: usize> Grid<D> {
                     }
                 });
         }
-        boundary.apply(&mut self.velocity);
-        boundary.apply(&mut self.new_velocity);
+        boundary.apply_live(&mut self.velocity, &self.live);
+        boundary.apply_live(&mut self.new_velocity, &self.live);
         if let Some(r) = reactions {
             r.0.reactions(boundary, &self.mass, &self.new_velocity, dt, &mut r.1);
         }

@@ -72,5 +72,5 @@ pub use settings::{Damping, StencilStorage, StepSettings, TimeStepControl};
 pub use simulation::{BodyForce, Simulation};
 pub use timing::StageTimes;
 pub use transfer::{
-    Apic, ApicFlip, Flip, Pic, StressUpdate, TransferScheme, VelocityGradientAffine,
+    Apic, ApicFlip, Flip, MlsMpm, Pic, StressUpdate, TransferScheme, VelocityGradientAffine,
 };

@@ -82,6 +82,22 @@ impl<const D: usize> Window<D> {
         sums.momentum += momentum;
         sums.force += force;
     }
+
+    /// Adds one stencil entry's mass and momentum to `node` (MLS-MPM, whose momentum
+    /// carries the force impulse: no separate force or stiffness).
+    #[inline]
+    pub fn add_momentum(
+        &mut self,
+        node: usize,
+        mass: f64,
+        abs_mass: f64,
+        momentum: SVector<f64, D>,
+    ) {
+        let sums = &mut self.sums[node - self.lo];
+        sums.mass += mass;
+        sums.abs_mass += abs_mass;
+        sums.momentum += momentum;
+    }
 }
 
 /// The nodal sums P2G produces.
@@ -136,14 +152,23 @@ impl<const D: usize> Scatter<D> {
     fn plan(&mut self, ranges: &[(u32, u32)], nodes: usize) {
         let particles = ranges.len();
         self.keys.clear();
-        self.keys.par_extend(
-            ranges
-                .par_iter()
-                .enumerate()
-                .map(|(p, &(lo, _))| (lo, p as u32)),
-        );
-        // Keys are unique (the index breaks ties), so the unstable sort is deterministic.
-        self.keys.par_sort_unstable();
+        if self.order.len() == particles {
+            // In the last step's order, which particles that moved a little keep nearly
+            // sorted: the merge sort below finds the sorted runs and has little to do.
+            let order = &self.order;
+            self.keys
+                .par_extend(order.par_iter().map(|&p| (ranges[p as usize].0, p)));
+        } else {
+            self.keys.par_extend(
+                ranges
+                    .par_iter()
+                    .enumerate()
+                    .map(|(p, &(lo, _))| (lo, p as u32)),
+            );
+        }
+        // Keys are unique (the index breaks ties), so the order they end in depends on
+        // the keys alone, not on where the sort started.
+        self.keys.par_sort();
         self.order.clear();
         self.order.extend(self.keys.iter().map(|&(_, p)| p));
         let order = &self.order;

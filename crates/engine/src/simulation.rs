@@ -28,6 +28,45 @@ mod particles_to_grid;
 pub type BodyForce<const D: usize> =
     std::sync::Arc<dyn Fn(&SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync>;
 
+/// Refuses what a fused-force transfer (MLS-MPM) cannot do: its D_p⁻¹ must be one
+/// constant (B-splines), and with no separate nodal force neither damping nor MUSL's
+/// re-mapped gradient would act as they say.
+fn check_transfer<const D: usize, K: Kernel<D>, T: TransferScheme>(
+    transfer: &T,
+    kernel: &K,
+    settings: &StepSettings<D>,
+) -> Result<(), EngineError> {
+    if !T::FUSED_FORCE {
+        return Ok(());
+    }
+    let unsupported = |setting, reason| {
+        Err(EngineError::Unsupported {
+            transfer: transfer.name(),
+            setting,
+            reason,
+        })
+    };
+    if kernel.constant_second_moment().is_none() {
+        return unsupported(
+            "a kernel whose second moment D_p varies (mesh kernels)",
+            "its force uses ∇N_i = D⁻¹ N_i (x_i − x_p) with one constant D (B-splines)",
+        );
+    }
+    if settings.damping != crate::settings::Damping::None {
+        return unsupported(
+            "damping",
+            "the force is folded into the momentum, and damping acts on the nodal force",
+        );
+    }
+    if settings.stress_update == StressUpdate::Musl {
+        return unsupported(
+            "the MUSL stress update",
+            "its velocity gradient is C_p, not one re-mapped from the grid",
+        );
+    }
+    Ok(())
+}
+
 /// An MPM simulation.
 pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> {
     /// The shape-function kernel (grid or mesh).
@@ -165,6 +204,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         settings: StepSettings<D>,
     ) -> Result<Self, EngineError> {
         settings.validate()?;
+        check_transfer(&transfer, &kernel, &settings)?;
         let nodes = kernel.node_count();
         let grid = Grid::new(nodes, particles.mass.iter().copied().fold(0.0, f64::max));
         Ok(Self {
@@ -437,6 +477,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     /// conditions, G2P, walls, deformation and stress update, failure checks.
     pub fn step(&mut self) -> Result<(), EngineError> {
         let step = self.step;
+        // The kernel and settings are public fields: a combination the transfer cannot
+        // work with may have been set since construction.
+        check_transfer(&self.transfer, &self.kernel, &self.settings)?;
         if self.totals.initial_energy.is_none() {
             let start = self.diagnostics()?;
             self.totals.initial_energy = Some(start.total_energy());
@@ -502,6 +545,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 .0
                 .record(&self.boundary, &self.grid.momentum, &self.grid.force, dt);
         }
+        self.boundary.sort_by_node();
         let report = self.grid.update(
             dt,
             self.material.p_wave_modulus(),

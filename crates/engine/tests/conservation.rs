@@ -7,8 +7,8 @@ use std::sync::Arc;
 use nalgebra::{SVector, Vector2};
 use umls_constitutive::{ElasticParameters, NeoHookean};
 use umls_engine::{
-    Apic, ApicFlip, Flip, Particles, Pic, Simulation, StepSettings, StressUpdate, TransferScheme,
-    VelocityGradientAffine,
+    Apic, ApicFlip, Flip, MlsMpm, Particles, Pic, Simulation, StepSettings, StressUpdate,
+    TransferScheme, VelocityGradientAffine,
 };
 use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, Umls2};
 use umls_mesh::generate::{Diagonal, Lattice};
@@ -92,6 +92,53 @@ fn mass_and_momentum_are_conserved_for_every_kernel_and_transfer() {
     every_transfer!(LinearFeKernel::new(mesh()));
     every_transfer!(grid(BSplineOrder::Quadratic));
     every_transfer!(grid(BSplineOrder::Cubic));
+    // MLS-MPM: B-splines and USL only (the combinations it refuses are tested below);
+    // its folded force Σ_i N_i (m C − Δt V τ D⁻¹)(x_i − x_p) vanishes with Σ_i N_i r_i.
+    check(grid(BSplineOrder::Quadratic), MlsMpm, StressUpdate::Usl);
+    check(grid(BSplineOrder::Cubic), MlsMpm, StressUpdate::Usl);
+}
+
+/// MLS-MPM's force needs one constant D_p and a nodal force it does not have: a mesh
+/// kernel, damping and MUSL are refused by name, at construction and at a step after
+/// the public settings changed.
+#[test]
+fn mls_mpm_refuses_what_it_cannot_do() {
+    let material = NeoHookean {
+        parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
+    };
+    let unsupported = |e: umls_engine::EngineError, what: &str| match &e {
+        umls_engine::EngineError::Unsupported {
+            transfer, setting, ..
+        } => {
+            assert_eq!(*transfer, "MLS-MPM");
+            assert!(setting.contains(what), "{e}");
+        }
+        other => panic!("expected Unsupported, got {other}"),
+    };
+    let settings = StepSettings::new(1e-4);
+    let mesh_kernel = Simulation::new(Umls2::new(mesh()), material, MlsMpm, disk(), settings);
+    unsupported(mesh_kernel.err().unwrap(), "kernel");
+    let mut musl = settings;
+    musl.stress_update = StressUpdate::Musl;
+    let refused = Simulation::new(
+        grid(BSplineOrder::Quadratic),
+        material,
+        MlsMpm,
+        disk(),
+        musl,
+    );
+    unsupported(refused.err().unwrap(), "MUSL");
+    let mut sim = Simulation::new(
+        grid(BSplineOrder::Quadratic),
+        material,
+        MlsMpm,
+        disk(),
+        settings,
+    )
+    .unwrap();
+    sim.step().unwrap();
+    sim.settings.damping = umls_engine::Damping::MassProportional { beta: 1.0 };
+    unsupported(sim.step().err().unwrap(), "damping");
 }
 
 #[test]

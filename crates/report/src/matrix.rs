@@ -279,11 +279,11 @@ impl Matrix {
     }
 }
 
-/// The scene edits of a transfer name: `pic`, `apic`, `flip:ALPHA` and `apic-flip:ALPHA`
-/// (`flip` and `apic-flip` alone have α = 1).
+/// The scene edits of a transfer name: `pic`, `apic`, `mls-mpm`, `flip:ALPHA` and
+/// `apic-flip:ALPHA` (`flip` and `apic-flip` alone have α = 1).
 pub fn transfer_edits(name: &str) -> Option<Vec<String>> {
     let (kind, alpha) = match name.split_once(':') {
-        None if name == "pic" || name == "apic" => {
+        None if name == "pic" || name == "apic" || name == "mls-mpm" => {
             return Some(vec![format!("transfer.kind={name}")]);
         }
         None => (name, "1.0"),
@@ -318,6 +318,7 @@ mod tests {
         for (name, expected) in [
             ("apic", "transfer.kind=apic"),
             ("pic", "transfer.kind=pic"),
+            ("mls-mpm", "transfer.kind=mls-mpm"),
             ("flip", "transfer.kind=flip transfer.alpha=1.0"),
             ("flip:0.99", "transfer.kind=flip transfer.alpha=0.99"),
             (

@@ -52,7 +52,9 @@ impl<const D: usize, T: TransferScheme> EntrySink<D> for GatherSums<'_, D, T> {
         if T::USES_FLIP {
             self.flip += (v - self.grid.old[node]) * n;
         }
-        self.grad_v += v * gradient.transpose();
+        if !T::FUSED_FORCE {
+            self.grad_v += v * gradient.transpose();
+        }
         if self.offsets {
             if self.moment_scale.is_none() {
                 self.d += r * r.transpose() * n;
@@ -115,7 +117,8 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
             0.0
         },
         affine,
-        velocity_gradient: grad_v,
+        // MLS-MPM takes C_p as the velocity gradient (its ∇N is D⁻¹ N r).
+        velocity_gradient: if T::FUSED_FORCE { affine } else { grad_v },
     })
 }
 

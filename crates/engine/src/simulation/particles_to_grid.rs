@@ -60,6 +60,13 @@ impl<const D: usize, T: TransferScheme> EntrySink<D> for ScatterEntry<'_, D, T> 
     #[inline(always)]
     fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, r: &SVector<f64, D>) {
         let m = self.mass;
+        if T::FUSED_FORCE {
+            // `velocity` is m (v + Δt a) and `affine` m C − Δt V τ D⁻¹ here.
+            let momentum = self.velocity + self.affine * r;
+            self.window
+                .add_momentum(node as usize, n * m, n.abs() * m, momentum * n);
+            return;
+        }
         let mut mv = self.velocity;
         if T::AFFINE {
             mv += self.affine * r;
@@ -95,6 +102,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // With a constant second moment (B-splines) the affine energy cannot grow as a
         // particle moves, and the limiter has nothing to do.
         let varying_moment = kernel.constant_second_moment().is_none();
+        // MLS-MPM's D (checked constant when the simulation starts and every step).
+        let second_moment = kernel.constant_second_moment().unwrap_or(f64::NAN);
+        let dt = self.dt;
         let ranges = stencils.ranges();
         self.scatter
             .scatter(ranges, sums, |block, window| {
@@ -127,7 +137,13 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                             }
                         })?;
                     } else {
-                        if T::AFFINE {
+                        if T::FUSED_FORCE {
+                            // MLS-MPM: ∇N_i ≈ D⁻¹ N_i r_i folds the stress impulse into
+                            // the affine term, and gravity into the momentum.
+                            let inverse_moment = 1.0 / second_moment;
+                            sink.affine = p.affine[i] * m - stress_volume * (dt * inverse_moment);
+                            sink.velocity = (v + acceleration * dt) * m;
+                        } else if T::AFFINE {
                             sink.affine = p.affine[i];
                         }
                         stencils.visit(
