@@ -3,7 +3,8 @@
 //! box of slip walls three cells in from its faces, APIC, Δt = 2·10⁻⁴. One step per
 //! iteration, in particle-steps per second, with 1 and 2 threads, for quadratic B-splines
 //! on the 64³ grid and UMLS on the 64³-cell Kuhn lattice of tetrahedra (1.57 M tets, the
-//! same node spacing). The comparison with Taichi runs the same scene through
+//! same node spacing), and quadratic B-splines with MLS-MPM (Taichi's own transfer: the
+//! force folded into the affine momentum). The comparison with Taichi runs the same scene through
 //! `umls run fluid-box-3d`; this bench isolates the step from scene set-up and output.
 
 use std::sync::Arc;
@@ -13,7 +14,10 @@ mod common;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::{SVector, Vector3};
 use umls::constitutive::WeaklyCompressibleFluid;
-use umls::engine::{Apic, Particles, Simulation, StepSettings, Wall, WallKind, lattice_points};
+use umls::engine::{
+    Apic, MlsMpm, Particles, Simulation, StepSettings, TransferScheme, Wall, WallKind,
+    lattice_points,
+};
 use umls::kernels::{BSplineKernel, BSplineOrder, Umls3};
 use umls::mesh::generate::Lattice;
 use umls::transfer::Kernel;
@@ -31,11 +35,15 @@ fn particles<C: Copy + Default>() -> Particles<3, (), C> {
 
 /// A simulation of the scene on `kernel`: slip conditions on the nodes on or beyond each
 /// wall, and the walls themselves for the particles.
-fn scene<K: Kernel<3>>(kernel: K) -> Simulation<3, K, WeaklyCompressibleFluid, Apic> {
+fn scene<K: Kernel<3>, T: TransferScheme>(
+    kernel: K,
+    transfer: T,
+) -> Simulation<3, K, WeaklyCompressibleFluid, T> {
     let material = WeaklyCompressibleFluid::new(400.0, 1.0).expect("valid");
     let mut settings = StepSettings::new(2e-4);
     settings.gravity = Vector3::new(0.0, -9.8, 0.0);
-    let mut sim = Simulation::new(kernel, material, Apic, particles(), settings).expect("valid");
+    let mut sim =
+        Simulation::new(kernel, material, transfer, particles(), settings).expect("valid");
     for axis in 0..3 {
         for (point, sign) in [(WALL, -1.0), (1.0 - WALL, 1.0)] {
             let normal = SVector::<f64, 3>::from_fn(|k, _| if k == axis { sign } else { 0.0 });
@@ -55,11 +63,16 @@ fn scene<K: Kernel<3>>(kernel: K) -> Simulation<3, K, WeaklyCompressibleFluid, A
     sim
 }
 
-fn bench<K: Kernel<3> + Clone>(c: &mut Criterion, name: &str, kernel: K) {
+fn bench<K: Kernel<3> + Clone, T: TransferScheme>(
+    c: &mut Criterion,
+    name: &str,
+    kernel: K,
+    transfer: T,
+) {
     let mut g = c.benchmark_group("fluid_box_3d_64k");
     g.throughput(Throughput::Elements(64_000));
     g.sample_size(10);
-    common::step_with_threads(&mut g, name, || scene(kernel.clone()));
+    common::step_with_threads(&mut g, name, || scene(kernel.clone(), transfer));
     g.finish();
 }
 
@@ -73,11 +86,12 @@ fn fluid_box(c: &mut Criterion) {
         BSplineOrder::Quadratic,
     )
     .expect("grid");
-    bench(c, "bspline2", grid);
+    bench(c, "bspline2", grid.clone(), Apic);
+    bench(c, "bspline2_mls_mpm", grid, MlsMpm);
     let mesh = Lattice::new([0.0; 3], [1.0; 3], [CELLS; 3])
         .tetrahedra()
         .expect("mesh");
-    bench(c, "umls_tet", Umls3::new(Arc::new(mesh)));
+    bench(c, "umls_tet", Umls3::new(Arc::new(mesh)), Apic);
 }
 
 criterion_group!(benches, fluid_box);
