@@ -160,6 +160,14 @@ impl<const D: usize> Stencils<D> {
         &self.ranges
     }
 
+    /// The chunk holding particle `p`'s stored stencil, and its entries' range there.
+    #[inline(always)]
+    fn stored_entries(&self, p: usize) -> (&ChunkStencils<D>, std::ops::Range<usize>) {
+        let chunk = &self.chunks[p / CHUNK];
+        let k = p % CHUNK;
+        (chunk, chunk.offsets[k]..chunk.offsets[k + 1])
+    }
+
     /// Hands every entry of particle `p`'s stencil to `sink`: the stored one, or the
     /// kernel's [`Kernel::visit_stencil`] at `x` from `cache` (same entries, same bits,
     /// and for a closed-form kernel no arrays written and read back). Stored stencils
@@ -178,9 +186,7 @@ impl<const D: usize> Stencils<D> {
         sink: &mut S,
     ) -> Result<(), (usize, KernelError)> {
         if self.stored {
-            let chunk = &self.chunks[p / CHUNK];
-            let k = p % CHUNK;
-            let range = chunk.offsets[k]..chunk.offsets[k + 1];
+            let (chunk, range) = self.stored_entries(p);
             for e in range {
                 let node = chunk.nodes[e];
                 let offset = if offsets {
@@ -216,9 +222,7 @@ impl<const D: usize> Stencils<D> {
         f: impl FnOnce(ParticleStencil<'_, D>) -> R,
     ) -> Result<R, (usize, KernelError)> {
         if self.stored {
-            let chunk = &self.chunks[p / CHUNK];
-            let k = p % CHUNK;
-            let range = chunk.offsets[k]..chunk.offsets[k + 1];
+            let (chunk, range) = self.stored_entries(p);
             return Ok(f(ParticleStencil {
                 nodes: &chunk.nodes[range.clone()],
                 values: &chunk.values[range.clone()],

@@ -169,6 +169,29 @@ impl TransferScheme for Apic {
     }
 }
 
+/// APIC's C_p = B_p D_p⁻¹ (and its closed form for a constant D_p) in the impl of a
+/// scheme that shares APIC's affine field.
+macro_rules! apic_affine {
+    () => {
+        fn affine<const D: usize>(
+            &self,
+            b: &SMatrix<f64, D, D>,
+            d: &SMatrix<f64, D, D>,
+            grad_v: &SMatrix<f64, D, D>,
+        ) -> SMatrix<f64, D, D> {
+            Apic.affine(b, d, grad_v)
+        }
+        fn affine_with_constant_moment<const D: usize>(
+            &self,
+            b: &SMatrix<f64, D, D>,
+            s: f64,
+            grad_v: &SMatrix<f64, D, D>,
+        ) -> SMatrix<f64, D, D> {
+            Apic.affine_with_constant_moment(b, s, grad_v)
+        }
+    };
+}
+
 impl TransferScheme for MlsMpm {
     const AFFINE: bool = true;
     const USES_MOMENTS: bool = true;
@@ -176,22 +199,7 @@ impl TransferScheme for MlsMpm {
     fn name(&self) -> &'static str {
         "MLS-MPM"
     }
-    fn affine<const D: usize>(
-        &self,
-        b: &SMatrix<f64, D, D>,
-        d: &SMatrix<f64, D, D>,
-        grad_v: &SMatrix<f64, D, D>,
-    ) -> SMatrix<f64, D, D> {
-        Apic.affine(b, d, grad_v)
-    }
-    fn affine_with_constant_moment<const D: usize>(
-        &self,
-        b: &SMatrix<f64, D, D>,
-        s: f64,
-        grad_v: &SMatrix<f64, D, D>,
-    ) -> SMatrix<f64, D, D> {
-        Apic.affine_with_constant_moment(b, s, grad_v)
-    }
+    apic_affine!();
 }
 
 impl TransferScheme for ApicFlip {
@@ -209,22 +217,7 @@ impl TransferScheme for ApicFlip {
     ) -> SVector<f64, D> {
         Flip { alpha: self.alpha }.velocity(old, pic, flip_increment)
     }
-    fn affine<const D: usize>(
-        &self,
-        b: &SMatrix<f64, D, D>,
-        d: &SMatrix<f64, D, D>,
-        grad_v: &SMatrix<f64, D, D>,
-    ) -> SMatrix<f64, D, D> {
-        Apic.affine(b, d, grad_v)
-    }
-    fn affine_with_constant_moment<const D: usize>(
-        &self,
-        b: &SMatrix<f64, D, D>,
-        s: f64,
-        grad_v: &SMatrix<f64, D, D>,
-    ) -> SMatrix<f64, D, D> {
-        Apic.affine_with_constant_moment(b, s, grad_v)
-    }
+    apic_affine!();
 }
 
 impl TransferScheme for VelocityGradientAffine {
