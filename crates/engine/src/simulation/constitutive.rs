@@ -73,6 +73,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .enumerate()
             .map(|(c, (((fs, states), gvs), stresses))| {
                 let mut min_density = f64::INFINITY;
+                // A failing particle does not stop its chunk: every particle is updated
+                // as far as it gets, whichever fails, and the first failure is reported.
+                let mut first_failure = None;
                 for (k, (((f, state), gv), stress)) in fs
                     .iter_mut()
                     .zip(states.iter_mut())
@@ -81,41 +84,61 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     .enumerate()
                 {
                     let i = c * chunk + k;
-                    let fail = |e| (i, e);
-                    *f = (SMatrix::<f64, D, D>::identity() + gv * dt) * *f;
-                    if !f.iter().all(|c| c.is_finite()) {
-                        return Err(fail(EngineError::NonFinite {
-                            step,
-                            field: "deformation gradient",
-                            entity: "particle",
-                            index: i,
-                        }));
+                    match update_one(material, f, state, gv, stress, dt, step, i) {
+                        Ok(det) => min_density = min_density.min(mass[i] / (volume[i] * det)),
+                        Err(e) => {
+                            first_failure.get_or_insert((i, e));
+                        }
                     }
-                    let det = umls_constitutive::determinant(f);
-                    if det <= 0.0 {
-                        return Err(fail(EngineError::Inverted {
-                            step,
-                            particle: i,
-                            det,
-                        }));
-                    }
-                    *stress = material.return_map_and_stress(f, state).map_err(|source| {
-                        fail(EngineError::Material {
-                            step,
-                            particle: i,
-                            source,
-                        })
-                    })?;
-                    min_density = min_density.min(mass[i] / (volume[i] * det));
                 }
-                Ok(min_density)
+                first_failure.map_or(Ok(min_density), Err)
             })
-            // Among failures the lowest particle index wins (a chunk stops at its
-            // first), so the report does not depend on the thread count.
+            // Among failures the lowest particle index wins, so the report does not
+            // depend on the thread count.
             .reduce(|| Ok(f64::INFINITY), |a, b| lowest_failure(a, b, f64::min))
             .map_err(|(_, e)| e);
         // Whole only if every particle got its stress.
         self.stresses_current = result.is_ok();
         result
     }
+}
+
+/// One particle's F ← (I + Δt ∇v) F, return map and stress; det F on success.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn update_one<const D: usize, M: Constitutive<D>>(
+    material: &M,
+    f: &mut SMatrix<f64, D, D>,
+    state: &mut M::State,
+    gv: &SMatrix<f64, D, D>,
+    stress: &mut SMatrix<f64, D, D>,
+    dt: f64,
+    step: usize,
+    i: usize,
+) -> Result<f64, EngineError> {
+    *f = (SMatrix::<f64, D, D>::identity() + gv * dt) * *f;
+    if !f.iter().all(|c| c.is_finite()) {
+        return Err(EngineError::NonFinite {
+            step,
+            field: "deformation gradient",
+            entity: "particle",
+            index: i,
+        });
+    }
+    let det = umls_constitutive::determinant(f);
+    if det <= 0.0 {
+        return Err(EngineError::Inverted {
+            step,
+            particle: i,
+            det,
+        });
+    }
+    *stress = material
+        .return_map_and_stress(f, state)
+        .map_err(|source| EngineError::Material {
+            step,
+            particle: i,
+            source,
+        })?;
+    Ok(det)
 }
