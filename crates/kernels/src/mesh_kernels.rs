@@ -4,12 +4,9 @@ use std::sync::Arc;
 
 use nalgebra::SVector;
 use std::marker::PhantomData;
-use umls_mesh::{Barycentric, SimplexMesh};
+use umls_mesh::{Barycentric, Located, SimplexMesh};
 
-use umls_mls::{
-    CubicBSpline, GradientKind, Linear, PolynomialBasis, Stencil as MlsStencil, UmlsKernel,
-    WeightFunction,
-};
+use umls_mls::{CubicBSpline, GradientKind, Linear, PolynomialBasis, UmlsKernel, WeightFunction};
 use umls_transfer::{DomainExit, Kernel, KernelError, Stencil};
 
 /// The node methods of a kernel whose nodes are the vertices of `self.mesh`.
@@ -102,6 +99,15 @@ fn locate<const D: usize>(
     x: &SVector<f64, D>,
     cache: &mut HostCache,
 ) -> Result<u32, KernelError> {
+    locate_with_coordinates(mesh, x, cache).map(|located| located.simplex)
+}
+
+/// [`locate`] with the barycentric coordinates the location computed anyway.
+fn locate_with_coordinates<const D: usize>(
+    mesh: &SimplexMesh<D>,
+    x: &SVector<f64, D>,
+    cache: &mut HostCache,
+) -> Result<Located<D>, KernelError> {
     let found = match cache.0 {
         Some(host) => mesh.locate_from(x, host),
         None => mesh.locate(x),
@@ -110,7 +116,7 @@ fn locate<const D: usize>(
         point: x.iter().copied().collect(),
     })?;
     cache.0 = Some(found.simplex);
-    Ok(found.simplex)
+    Ok(found)
 }
 
 /// The UMLS kernel (C¹ diminishing-weight MLS over the host's 1-ring) as an MPM kernel.
@@ -206,14 +212,29 @@ where
         cache: &mut HostCache,
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError> {
-        let host = locate(&self.mesh, x, cache)?;
-        let mut mls = MlsStencil::new();
-        self.kernel
-            .evaluate::<N, B>(&self.mesh, host, x, self.gradient, &mut mls)
-            .map_err(|e| KernelError::evaluation("UMLS", e))?;
-        out.clear();
-        for (v, n, g) in mls.iter() {
-            out.push(v, n, *g, self.mesh.vertex(v as usize) - x);
+        let located = locate_with_coordinates(&self.mesh, x, cache)?;
+        // Written in place: no fixed-capacity stencil between the fit and `out`.
+        let ring = self
+            .mesh
+            .topology()
+            .one_ring(located.simplex as usize)
+            .len();
+        let entries = out.entries_mut(ring);
+        let evaluated = self.kernel.evaluate_into::<N, B>(
+            &self.mesh,
+            &located,
+            x,
+            self.gradient,
+            entries.nodes,
+            entries.values,
+            entries.gradients,
+        );
+        if let Err(e) = evaluated {
+            out.clear();
+            return Err(KernelError::evaluation("UMLS", e));
+        }
+        for (offset, &v) in entries.offsets.iter_mut().zip(entries.nodes.iter()) {
+            *offset = self.mesh.vertex(v as usize) - x;
         }
         Ok(())
     }

@@ -44,6 +44,22 @@ pub enum MlsError {
         /// Number of weight gradients.
         gradients: usize,
     },
+    /// Output slices whose length is not the host's 1-ring size.
+    #[error(
+        "the 1-ring of simplex {simplex} has {ring} vertices but the output slices hold {nodes} nodes, {values} values and {gradients} gradients"
+    )]
+    OutputLength {
+        /// Host simplex.
+        simplex: u32,
+        /// Number of 1-ring vertices.
+        ring: usize,
+        /// Length of the node slice.
+        nodes: usize,
+        /// Length of the value slice.
+        values: usize,
+        /// Length of the gradient slice.
+        gradients: usize,
+    },
     /// A weight that is negative or not finite.
     #[error("sample {sample} has invalid weight {weight:.4e}")]
     InvalidWeight {

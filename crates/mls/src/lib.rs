@@ -15,6 +15,8 @@
 //! w_v = η_v · d_v combine the [`diminishing_factor`] η_v = Σ_n λ_n A_{v,n} with a radial
 //! weight d_v. Shape functions and reconstructed gradients are continuous across facets
 //! (the tests measure the jumps), unlike linear finite-element shape functions.
+//! [`UmlsKernel::evaluate_into`] writes the same values straight into a caller's arrays
+//! of any length (an MPM engine's stencil storage), with no intermediate stencil.
 //!
 //! ```
 //! use nalgebra::Vector2;
@@ -37,6 +39,7 @@
 //! ```
 
 mod basis;
+mod cholesky;
 mod diminishing;
 mod error;
 mod point_cloud;

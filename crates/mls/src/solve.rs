@@ -12,9 +12,10 @@
 //! (MLS shape functions do not depend on where a complete basis is centred), so that only
 //! the weights depend on x; the terms are then evaluated with the centre at x.
 
-use nalgebra::{Cholesky, SMatrix, SVector};
+use nalgebra::{SMatrix, SVector};
 
 use crate::basis::PolynomialBasis;
+use crate::cholesky::spd_inverse;
 use crate::error::MlsError;
 use crate::stencil::{GradientKind, MAX_STENCIL, Stencil};
 
@@ -115,47 +116,28 @@ pub fn shape_functions<const D: usize, const N: usize, B: PolynomialBasis<D, N>>
     let inv_scale = 1.0 / scale;
     let basis = |v: usize| B::evaluate(&((samples.positions[v] - x) * inv_scale));
 
-    let mut moment = SMatrix::<f64, N, N>::zeros();
-    let mut positive = 0;
-    for (v, &w) in samples.weights.iter().enumerate() {
-        if !(w.is_finite() && w >= 0.0) {
-            return Err(MlsError::InvalidWeight {
-                sample: v,
-                weight: w,
-            });
-        }
-        if w > 0.0 {
-            let p = basis(v);
-            moment.ger(w, &p, &p, 1.0);
-            positive += 1;
-        }
-    }
-    if conditioning.higher_order_ridge > 0.0 && moment[(0, 0)] > 0.0 {
-        // The ridge must not depend on the scale s (it differs between neighbouring
-        // hosts): with ℓ² = Σw|ξ|² / Σw, the weighted spread of the samples, the shift
-        // Σw · ℓ⁴ scales like the quadratic monomials' entries (s⁻⁴), so the regularised
-        // fit is the same for every s and stays continuous across facets.
-        let spread: f64 = (1..=D).map(|i| moment[(i, i)]).sum();
-        let shift = conditioning.higher_order_ridge * spread * spread / moment[(0, 0)];
-        for i in D + 1..N {
-            moment[(i, i)] += shift;
-        }
-    }
-    let (inverse, condition) = invert(moment, positive, conditioning)?;
-
     out.len = n;
     out.nodes[..n].copy_from_slice(samples.nodes);
+    out.values[..n].copy_from_slice(samples.weights);
+    for (xi, position) in out.gradients[..n].iter_mut().zip(samples.positions) {
+        *xi = (position - x) * inv_scale;
+    }
+    let solved = shape_functions_in_place::<D, N, B>(
+        &mut out.values[..n],
+        &mut out.gradients[..n],
+        inv_scale,
+        conditioning,
+    );
+    let (inverse, condition) = match solved {
+        Ok(solved) => solved,
+        Err(error) => {
+            out.clear();
+            return Err(error);
+        }
+    };
     out.condition = condition;
     out.gradient_kind = gradient;
     let a = inverse.column(0).into_owned();
-    for v in 0..n {
-        let w = samples.weights[v];
-        let p = basis(v);
-        let g = a.dot(&p);
-        out.values[v] = w * g;
-        out.gradients[v] =
-            SVector::<f64, D>::from_fn(|k, _| w * inverse.column(k + 1).dot(&p) * inv_scale);
-    }
     if needs_weight_gradients {
         // r_k = Σ_u ∂_k w_u g_u p_u, stored as the columns of an N×D matrix.
         let mut r = SMatrix::<f64, N, D>::zeros();
@@ -174,6 +156,58 @@ pub fn shape_functions<const D: usize, const N: usize, B: PolynomialBasis<D, N>>
     Ok(())
 }
 
+/// The MLS solve with the reconstructed gradient, written over its own input so that an
+/// evaluation needs no sample arrays besides the stencil it fills.
+///
+/// On entry `values[v]` holds the weight w_v ≥ 0 and `gradients[v]` the scaled offset
+/// ξ_v = (x_v − x)/s; on return they hold N_v and the reconstructed gradient ∇̃N_v.
+/// `inv_scale` is 1/s. Returns M⁻¹ and its 1-norm condition number. [`shape_functions`]
+/// calls it, so both give the same bits.
+pub(crate) fn shape_functions_in_place<const D: usize, const N: usize, B: PolynomialBasis<D, N>>(
+    values: &mut [f64],
+    gradients: &mut [SVector<f64, D>],
+    inv_scale: f64,
+    conditioning: &Conditioning,
+) -> Result<(SMatrix<f64, N, N>, f64), MlsError> {
+    let mut moment = SMatrix::<f64, N, N>::zeros();
+    let mut positive = 0;
+    for (v, (&w, xi)) in values.iter().zip(gradients.iter()).enumerate() {
+        if !(w.is_finite() && w >= 0.0) {
+            return Err(MlsError::InvalidWeight {
+                sample: v,
+                weight: w,
+            });
+        }
+        if w > 0.0 {
+            let p = B::evaluate(xi);
+            moment.ger(w, &p, &p, 1.0);
+            positive += 1;
+        }
+    }
+    if conditioning.higher_order_ridge > 0.0 && moment[(0, 0)] > 0.0 {
+        // The ridge must not depend on the scale s (it differs between neighbouring
+        // hosts): with ℓ² = Σw|ξ|² / Σw, the weighted spread of the samples, the shift
+        // Σw · ℓ⁴ scales like the quadratic monomials' entries (s⁻⁴), so the regularised
+        // fit is the same for every s and stays continuous across facets.
+        let spread: f64 = (1..=D).map(|i| moment[(i, i)]).sum();
+        let shift = conditioning.higher_order_ridge * spread * spread / moment[(0, 0)];
+        for i in D + 1..N {
+            moment[(i, i)] += shift;
+        }
+    }
+    let (inverse, condition) = invert(moment, positive, conditioning)?;
+    let a = inverse.column(0).into_owned();
+    for (value, gradient) in values.iter_mut().zip(gradients.iter_mut()) {
+        let w = *value;
+        let p = B::evaluate(gradient);
+        let g = a.dot(&p);
+        *value = w * g;
+        *gradient =
+            SVector::<f64, D>::from_fn(|k, _| w * inverse.column(k + 1).dot(&p) * inv_scale);
+    }
+    Ok((inverse, condition))
+}
+
 /// Inverts the SPD moment matrix, estimating κ₁ = ‖M‖₁‖M⁻¹‖₁ and applying the policy.
 fn invert<const N: usize>(
     moment: SMatrix<f64, N, N>,
@@ -181,9 +215,8 @@ fn invert<const N: usize>(
     conditioning: &Conditioning,
 ) -> Result<(SMatrix<f64, N, N>, f64), MlsError> {
     let attempt = |m: SMatrix<f64, N, N>| -> (Option<SMatrix<f64, N, N>>, f64) {
-        match Cholesky::new(m) {
-            Some(chol) => {
-                let inverse = chol.inverse();
+        match spd_inverse(&m) {
+            Some(inverse) => {
                 let condition = one_norm(&m) * one_norm(&inverse);
                 (
                     Some(inverse),

@@ -2,13 +2,13 @@
 //! w_v = η_v · d_v (Cao et al., arXiv 2312.10338).
 
 use nalgebra::SVector;
-use umls_mesh::{INSIDE_TOLERANCE, SimplexMesh};
+use umls_mesh::{Barycentric, INSIDE_TOLERANCE, Located, SimplexMesh};
 
 use crate::basis::PolynomialBasis;
 use crate::diminishing::{diminishing_factor, diminishing_gradient};
 use crate::error::MlsError;
 use crate::point_cloud::radial_weight;
-use crate::solve::{Conditioning, Samples, shape_functions};
+use crate::solve::{Conditioning, Samples, shape_functions, shape_functions_in_place};
 use crate::stencil::{GradientKind, MAX_STENCIL, Stencil};
 use crate::weight::{CubicBSpline, WeightFunction};
 
@@ -160,6 +160,123 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
         gradient: GradientKind,
         out: &mut Stencil<D>,
     ) -> Result<(), MlsError> {
+        let lambda = self.host_coordinates(mesh, host, x)?;
+        let ring = mesh.topology().one_ring(host as usize);
+        if ring.len() > MAX_STENCIL {
+            return Err(MlsError::StencilOverflow {
+                simplex: Some(host),
+                samples: ring.len(),
+                capacity: MAX_STENCIL,
+            });
+        }
+        let n = ring.len();
+        if gradient == GradientKind::Reconstructed {
+            let filled = self.reconstructed::<N, B>(
+                mesh,
+                host,
+                x,
+                &lambda,
+                &mut out.nodes[..n],
+                &mut out.values[..n],
+                &mut out.gradients[..n],
+            );
+            return match filled {
+                Ok(condition) => {
+                    out.len = n;
+                    out.condition = condition;
+                    out.gradient_kind = gradient;
+                    Ok(())
+                }
+                Err(error) => {
+                    out.clear();
+                    Err(error)
+                }
+            };
+        }
+        let lambda_gradients = mesh.barycentric_gradients(host as usize);
+        let mut positions = [SVector::<f64, D>::zeros(); MAX_STENCIL];
+        let mut weights = [0.0; MAX_STENCIL];
+        let mut weight_gradients = [SVector::<f64, D>::zeros(); MAX_STENCIL];
+        for (i, (&v, &mask)) in ring.vertices.iter().zip(ring.masks).enumerate() {
+            let xv = mesh.vertex(v as usize);
+            let h = self.radii[v as usize];
+            let (d, dd) = radial_weight(&self.weight, x, xv, h);
+            let eta = diminishing_factor(mask, lambda.as_slice());
+            positions[i] = *xv;
+            weights[i] = eta * d;
+            weight_gradients[i] =
+                diminishing_gradient(mask, lambda_gradients.as_slice()) * d + dd * eta;
+        }
+        let samples = Samples {
+            nodes: ring.vertices,
+            positions: &positions[..n],
+            weights: &weights[..n],
+            weight_gradients: &weight_gradients[..n],
+        };
+        shape_functions::<D, N, B>(
+            x,
+            &samples,
+            self.scale(mesh, host),
+            gradient,
+            &self.conditioning,
+            out,
+        )
+        .map_err(|e| with_host(e, host))
+    }
+
+    /// [`Self::evaluate`] written into the caller's slices, whose length must be the
+    /// host's 1-ring size (`mesh.topology().one_ring(host).len()`), so that a caller
+    /// with its own stencil storage (an MPM engine's) needs no intermediate copy.
+    /// `located` is the host with the barycentric coordinates of `x` in it, as
+    /// [`SimplexMesh::locate`] and [`SimplexMesh::locate_from`] give them (they are not
+    /// computed again; a caller holding only the host builds them with
+    /// [`SimplexMesh::barycentric`]). With the reconstructed gradient no array of the fit
+    /// is bounded, so any ring size is accepted; the full gradient keeps the
+    /// [`MAX_STENCIL`] cap. Same values as [`Self::evaluate`], bit for bit; returns the
+    /// moment matrix's condition number.
+    #[allow(clippy::too_many_arguments)]
+    pub fn evaluate_into<const N: usize, B: PolynomialBasis<D, N>>(
+        &self,
+        mesh: &SimplexMesh<D>,
+        located: &Located<D>,
+        x: &SVector<f64, D>,
+        gradient: GradientKind,
+        nodes: &mut [u32],
+        values: &mut [f64],
+        gradients: &mut [SVector<f64, D>],
+    ) -> Result<f64, MlsError> {
+        let host = located.simplex;
+        self.check_host(mesh, host)?;
+        let lambda = &located.barycentric;
+        if lambda.min() < -HOST_TOLERANCE {
+            return Err(MlsError::OutsideHost {
+                simplex: host,
+                min_barycentric: lambda.min(),
+            });
+        }
+        let ring = mesh.topology().one_ring(host as usize).len();
+        if nodes.len() != ring || values.len() != ring || gradients.len() != ring {
+            return Err(MlsError::OutputLength {
+                simplex: host,
+                ring,
+                nodes: nodes.len(),
+                values: values.len(),
+                gradients: gradients.len(),
+            });
+        }
+        if gradient == GradientKind::Reconstructed {
+            return self.reconstructed::<N, B>(mesh, host, x, lambda, nodes, values, gradients);
+        }
+        let mut stencil = Stencil::new();
+        self.evaluate::<N, B>(mesh, host, x, gradient, &mut stencil)?;
+        nodes.copy_from_slice(stencil.nodes());
+        values.copy_from_slice(stencil.values());
+        gradients.copy_from_slice(stencil.gradients());
+        Ok(stencil.condition_number())
+    }
+
+    /// Checks that `host` is a simplex of `mesh` and that the kernel was built for it.
+    fn check_host(&self, mesh: &SimplexMesh<D>, host: u32) -> Result<(), MlsError> {
         if host as usize >= mesh.simplex_count() {
             return Err(MlsError::NoSuchSimplex {
                 simplex: host,
@@ -173,6 +290,18 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
                 reason: "differs from the mesh this kernel was built for",
             });
         }
+        Ok(())
+    }
+
+    /// The host's barycentric coordinates of `x`, after checking the host, the mesh and
+    /// that `x` lies in the host.
+    fn host_coordinates(
+        &self,
+        mesh: &SimplexMesh<D>,
+        host: u32,
+        x: &SVector<f64, D>,
+    ) -> Result<Barycentric<D>, MlsError> {
+        self.check_host(mesh, host)?;
         let lambda = mesh.barycentric(host as usize, x);
         if lambda.min() < -HOST_TOLERANCE {
             return Err(MlsError::OutsideHost {
@@ -180,42 +309,55 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
                 min_barycentric: lambda.min(),
             });
         }
-        let ring = mesh.topology().one_ring(host as usize);
-        if ring.len() > MAX_STENCIL {
-            return Err(MlsError::StencilOverflow {
-                simplex: Some(host),
-                samples: ring.len(),
-                capacity: MAX_STENCIL,
+        Ok(lambda)
+    }
+
+    /// The length the coordinates are scaled by: any length of the order of the local
+    /// spacing makes M O(1); the host's first vertex radius is at hand and constant on
+    /// the host.
+    fn scale(&self, mesh: &SimplexMesh<D>, host: u32) -> f64 {
+        self.radii[mesh.simplex(host as usize)[0] as usize]
+    }
+
+    /// The reconstructed-gradient evaluation, written straight into slices of the ring's
+    /// length: weights and scaled offsets first, then the in-place solve over them.
+    #[allow(clippy::too_many_arguments)]
+    fn reconstructed<const N: usize, B: PolynomialBasis<D, N>>(
+        &self,
+        mesh: &SimplexMesh<D>,
+        host: u32,
+        x: &SVector<f64, D>,
+        lambda: &Barycentric<D>,
+        nodes: &mut [u32],
+        values: &mut [f64],
+        gradients: &mut [SVector<f64, D>],
+    ) -> Result<f64, MlsError> {
+        let scale = self.scale(mesh, host);
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(MlsError::InvalidParameter {
+                parameter: "scale",
+                value: scale,
+                reason: "must be finite and positive",
             });
         }
-        let lambda_gradients = mesh.barycentric_gradients(host as usize);
-        let full = gradient == GradientKind::Full;
-        let mut positions = [SVector::<f64, D>::zeros(); MAX_STENCIL];
-        let mut weights = [0.0; MAX_STENCIL];
-        let mut weight_gradients = [SVector::<f64, D>::zeros(); MAX_STENCIL];
-        for (i, (&v, &mask)) in ring.vertices.iter().zip(ring.masks).enumerate() {
+        let inv_scale = 1.0 / scale;
+        let ring = mesh.topology().one_ring(host as usize);
+        for ((((&v, &mask), node), value), xi) in ring
+            .vertices
+            .iter()
+            .zip(ring.masks)
+            .zip(nodes.iter_mut())
+            .zip(values.iter_mut())
+            .zip(gradients.iter_mut())
+        {
             let xv = mesh.vertex(v as usize);
-            let h = self.radii[v as usize];
-            let (d, dd) = radial_weight(&self.weight, x, xv, h);
-            let eta = diminishing_factor(mask, lambda.as_slice());
-            positions[i] = *xv;
-            weights[i] = eta * d;
-            if full {
-                weight_gradients[i] =
-                    diminishing_gradient(mask, lambda_gradients.as_slice()) * d + dd * eta;
-            }
+            let (d, _) = radial_weight(&self.weight, x, xv, self.radii[v as usize]);
+            *node = v;
+            *value = diminishing_factor(mask, lambda.as_slice()) * d;
+            *xi = (xv - x) * inv_scale;
         }
-        let n = ring.len();
-        let samples = Samples {
-            nodes: ring.vertices,
-            positions: &positions[..n],
-            weights: &weights[..n],
-            weight_gradients: &weight_gradients[..n],
-        };
-        // Any length of the order of the local spacing makes M O(1); the host's first
-        // vertex radius is at hand and constant on the host.
-        let scale = self.radii[mesh.simplex(host as usize)[0] as usize];
-        shape_functions::<D, N, B>(x, &samples, scale, gradient, &self.conditioning, out)
+        shape_functions_in_place::<D, N, B>(values, gradients, inv_scale, &self.conditioning)
+            .map(|(_, condition)| condition)
             .map_err(|e| with_host(e, host))
     }
 
