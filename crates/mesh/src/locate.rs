@@ -29,8 +29,6 @@ pub struct Located<const D: usize> {
 /// The spatial index used for location without a hint.
 #[derive(Debug, Clone)]
 pub(crate) enum SpatialIndex {
-    /// Placeholder during construction.
-    Empty,
     /// 1D: simplices as (min, max, index) sorted by min; intervals of a valid mesh do not overlap.
     Intervals(Vec<(f64, f64, u32)>),
     #[cfg(feature = "dim2")]
@@ -40,14 +38,18 @@ pub(crate) enum SpatialIndex {
 }
 
 impl SpatialIndex {
-    pub(crate) fn build<const D: usize>(mesh: &SimplexMesh<D>) -> Result<Self, MeshError> {
+    pub(crate) fn build<const D: usize>(
+        vertices: &[Point<D>],
+        simplices: &[u32],
+        max_edge: f64,
+    ) -> Result<Self, MeshError> {
         // Boxes are inflated so that points on a facet, up to round-off, fall into them.
-        let pad = 1e-9 * mesh.max_edge_length();
-        let boxes = (0..mesh.simplex_count()).map(|s| {
-            let corners = mesh.corners(s);
+        let pad = 1e-9 * max_edge;
+        let boxes = simplices.chunks_exact(D + 1).map(|simplex| {
             let mut lo = Point::<D>::repeat(f64::INFINITY);
             let mut hi = Point::<D>::repeat(f64::NEG_INFINITY);
-            for c in &corners[..=D] {
+            for &v in simplex {
+                let c = &vertices[v as usize];
                 lo = lo.inf(c);
                 hi = hi.sup(c);
             }
@@ -121,7 +123,6 @@ impl SpatialIndex {
     /// Calls `visit` with every simplex whose (padded) bounding box contains `x`.
     fn for_each_candidate<const D: usize>(&self, x: &Point<D>, mut visit: impl FnMut(u32)) {
         match self {
-            Self::Empty => {}
             Self::Intervals(intervals) => {
                 // The last interval starting at or before x, and its predecessor for x on a shared vertex.
                 let end = intervals.partition_point(|iv| iv.0 <= x[0]);

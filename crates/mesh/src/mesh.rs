@@ -3,6 +3,7 @@
 use std::collections::HashMap;
 
 use nalgebra::{SMatrix, SVector};
+use rayon::prelude::*;
 
 use crate::barycentric::{Barycentric, BarycentricGradients, MAX_SIMPLEX_VERTICES};
 use crate::error::MeshError;
@@ -51,6 +52,91 @@ pub struct SimplexMesh<const D: usize> {
     pub(crate) min_height: f64,
 }
 
+/// Simplices per parallel work item of the validation.
+const VALIDATION_CHUNK: usize = 4096;
+
+/// What validating one simplex yields.
+struct SimplexGeometry<const D: usize> {
+    inverse: SMatrix<f64, D, D>,
+    volume: f64,
+    longest: f64,
+    shortest: f64,
+}
+
+/// Validates simplex `simplex` (vertex indices in range and distinct, not degenerate,
+/// oriented per `orientation`, swapping its last two vertices to fix it) and computes
+/// its inverse edge map and volume.
+fn simplex_geometry<const D: usize>(
+    simplex: usize,
+    verts: &mut [u32],
+    vertices: &[Point<D>],
+    orientation: Orientation,
+) -> Result<SimplexGeometry<D>, MeshError> {
+    let stride = D + 1;
+    for (local, &index) in verts.iter().enumerate() {
+        if index as usize >= vertices.len() {
+            return Err(MeshError::VertexIndexOutOfRange {
+                simplex,
+                local,
+                index,
+                vertex_count: vertices.len(),
+            });
+        }
+        if verts[..local].contains(&index) {
+            return Err(MeshError::RepeatedVertex {
+                simplex,
+                vertex: index,
+            });
+        }
+    }
+    let mut corners = [Point::<D>::zeros(); MAX_SIMPLEX_VERTICES];
+    for (c, &v) in corners.iter_mut().zip(verts.iter()) {
+        *c = vertices[v as usize];
+    }
+    let corners = &corners[..stride];
+    let longest = longest_edge(corners);
+    let shortest = crate::geometry::shortest_edge(corners);
+    let mut volume = signed_volume(corners);
+    let tolerance = DEGENERACY_TOLERANCE * longest.powi(D as i32);
+    if volume.abs() <= tolerance {
+        return Err(MeshError::DegenerateSimplex {
+            simplex,
+            volume,
+            tolerance,
+        });
+    }
+    if volume < 0.0 {
+        match orientation {
+            Orientation::Reject => {
+                return Err(MeshError::InvertedSimplex { simplex, volume });
+            }
+            Orientation::Fix => {
+                // Swapping two vertices flips the sign of the determinant.
+                verts.swap(D - 1, D);
+                volume = -volume;
+            }
+        }
+    }
+    let mut fixed = [Point::<D>::zeros(); MAX_SIMPLEX_VERTICES];
+    for (c, &v) in fixed.iter_mut().zip(verts.iter()) {
+        *c = vertices[v as usize];
+    }
+    let inverse =
+        edge_matrix(&fixed[..stride])
+            .try_inverse()
+            .ok_or(MeshError::DegenerateSimplex {
+                simplex,
+                volume,
+                tolerance,
+            })?;
+    Ok(SimplexGeometry {
+        inverse,
+        volume,
+        longest,
+        shortest,
+    })
+}
+
 impl<const D: usize> SimplexMesh<D> {
     /// Builds a mesh from vertex coordinates and flat connectivity (D+1 indices per simplex).
     ///
@@ -89,87 +175,61 @@ impl<const D: usize> SimplexMesh<D> {
             }
         }
 
-        let mut inverse_maps = Vec::with_capacity(n_simplices);
-        let mut volumes = Vec::with_capacity(n_simplices);
-        let mut max_edge: f64 = 0.0;
-        let mut min_edge = f64::INFINITY;
-        for (simplex, verts) in simplices.chunks_exact_mut(stride).enumerate() {
-            for (local, &index) in verts.iter().enumerate() {
-                if index as usize >= vertices.len() {
-                    return Err(MeshError::VertexIndexOutOfRange {
-                        simplex,
-                        local,
-                        index,
-                        vertex_count: vertices.len(),
-                    });
+        // Validation and the per-simplex geometry run in parallel over chunks; each chunk
+        // stops at its first invalid simplex and the lowest one is reported, so the error
+        // is the one a serial loop would give.
+        let mut inverse_maps = vec![SMatrix::<f64, D, D>::zeros(); n_simplices];
+        let mut volumes = vec![0.0; n_simplices];
+        let extremes = simplices
+            .par_chunks_mut(VALIDATION_CHUNK * stride)
+            .zip(inverse_maps.par_chunks_mut(VALIDATION_CHUNK))
+            .zip(volumes.par_chunks_mut(VALIDATION_CHUNK))
+            .enumerate()
+            .map(|(chunk, ((verts, inverses), vols))| {
+                let first = chunk * VALIDATION_CHUNK;
+                let mut extremes = (0.0_f64, f64::INFINITY);
+                for (k, ((verts, inverse), volume)) in verts
+                    .chunks_exact_mut(stride)
+                    .zip(inverses.iter_mut())
+                    .zip(vols.iter_mut())
+                    .enumerate()
+                {
+                    let geometry = simplex_geometry(first + k, verts, &vertices, orientation)?;
+                    *inverse = geometry.inverse;
+                    *volume = geometry.volume;
+                    extremes.0 = extremes.0.max(geometry.longest);
+                    extremes.1 = extremes.1.min(geometry.shortest);
                 }
-                if verts[..local].contains(&index) {
-                    return Err(MeshError::RepeatedVertex {
-                        simplex,
-                        vertex: index,
-                    });
-                }
-            }
-            let mut corners = [Point::<D>::zeros(); MAX_SIMPLEX_VERTICES];
-            for (c, &v) in corners.iter_mut().zip(verts.iter()) {
-                *c = vertices[v as usize];
-            }
-            let corners = &corners[..stride];
-            let longest = longest_edge(corners);
+                Ok(extremes)
+            })
+            .collect::<Vec<Result<(f64, f64), MeshError>>>();
+        let (mut max_edge, mut min_edge) = (0.0_f64, f64::INFINITY);
+        for chunk in extremes {
+            let (longest, shortest) = chunk?;
             max_edge = max_edge.max(longest);
-            min_edge = min_edge.min(crate::geometry::shortest_edge(corners));
-            let mut volume = signed_volume(corners);
-            let tolerance = DEGENERACY_TOLERANCE * longest.powi(D as i32);
-            if volume.abs() <= tolerance {
-                return Err(MeshError::DegenerateSimplex {
-                    simplex,
-                    volume,
-                    tolerance,
-                });
-            }
-            if volume < 0.0 {
-                match orientation {
-                    Orientation::Reject => {
-                        return Err(MeshError::InvertedSimplex { simplex, volume });
-                    }
-                    Orientation::Fix => {
-                        // Swapping two vertices flips the sign of the determinant.
-                        verts.swap(D - 1, D);
-                        volume = -volume;
-                    }
-                }
-            }
-            let mut fixed = [Point::<D>::zeros(); MAX_SIMPLEX_VERTICES];
-            for (c, &v) in fixed.iter_mut().zip(verts.iter()) {
-                *c = vertices[v as usize];
-            }
-            let inverse = edge_matrix(&fixed[..stride]).try_inverse().ok_or(
-                MeshError::DegenerateSimplex {
-                    simplex,
-                    volume,
-                    tolerance,
-                },
-            )?;
-            inverse_maps.push(inverse);
-            volumes.push(volume);
+            min_edge = min_edge.min(shortest);
         }
 
-        let topology = Topology::build(vertices.len(), &simplices, &inverse_maps, &volumes)?;
+        // The BVH is built serially by parry; it runs beside the (parallel) topology.
+        let (topology, index) = rayon::join(
+            || Topology::build(vertices.len(), &simplices, &inverse_maps, &volumes),
+            || SpatialIndex::build::<D>(&vertices, &simplices, max_edge),
+        );
         let mut mesh = Self {
             vertices,
             simplices,
             inverse_maps,
             volumes,
-            topology,
-            index: SpatialIndex::Empty,
+            topology: topology?,
+            index: index?,
             max_edge,
             min_edge,
             min_height: 0.0,
         };
         mesh.min_height = (0..mesh.simplex_count())
+            .into_par_iter()
             .map(|s| mesh.height(s))
-            .fold(f64::INFINITY, f64::min);
-        mesh.index = SpatialIndex::build(&mesh)?;
+            .reduce(|| f64::INFINITY, f64::min);
         Ok(mesh)
     }
 

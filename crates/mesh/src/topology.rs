@@ -334,16 +334,27 @@ pub(crate) fn barycentric_gradient<const D: usize>(
 
 /// The rows that parallel chunks built (each chunk's row lengths and values back to
 /// back), joined in chunk order into one CSR.
-fn joined<'a, T: Copy + 'a>(
+fn joined<'a, T: Copy + Default + Send + Sync + 'a>(
     lengths: impl Iterator<Item = &'a [usize]>,
     values: impl Iterator<Item = &'a [T]>,
     what: &'static str,
 ) -> Result<Csr<T>, MeshError> {
-    Csr::from_lengths(
-        lengths.flatten().copied(),
-        values.flatten().copied().collect(),
-        what,
-    )
+    // The chunks are copied into their places in parallel: for the 1-rings of a large
+    // mesh this is hundreds of megabytes, and a serial copy was a third of the build.
+    let values: Vec<&[T]> = values.collect();
+    let mut joined = vec![T::default(); values.iter().map(|v| v.len()).sum()];
+    let mut places = Vec::with_capacity(values.len());
+    let mut rest = &mut joined[..];
+    for v in &values {
+        let (place, tail) = rest.split_at_mut(v.len());
+        places.push(place);
+        rest = tail;
+    }
+    places
+        .into_par_iter()
+        .zip(values)
+        .for_each(|(place, v)| place.copy_from_slice(v));
+    Csr::from_lengths(lengths.flatten().copied(), joined, what)
 }
 
 fn non_manifold(key: [u32; 3], first: u32, second: u32, third: usize) -> MeshError {

@@ -137,3 +137,59 @@ proptest! {
         }
     }
 }
+
+/// Validation runs in parallel chunks of simplices; with invalid simplices in several
+/// chunks the error is still the first one in simplex order, on any number of threads,
+/// and inverted simplices are fixed in every chunk.
+#[test]
+fn the_first_invalid_simplex_is_reported_whatever_the_chunking_and_threads() {
+    use umls_mesh::generate::{Diagonal, Lattice};
+    let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [120, 120])
+        .triangles(Diagonal::Right)
+        .expect("valid lattice");
+    let vertices = mesh.vertices().to_vec();
+    let good: Vec<u32> = mesh.connectivity().to_vec();
+    let n = mesh.simplex_count();
+    assert!(n > 3 * 4096, "the mesh must span several validation chunks");
+    let (early, late) = (5_000, n - 10);
+    let mut bad = good.clone();
+    // A repeated vertex late, an out-of-range index early: the early one is reported.
+    bad[late * 3 + 1] = bad[late * 3];
+    bad[early * 3 + 2] = vertices.len() as u32 + 3;
+    // Inverted simplices in the first and the last chunk are fixed (Orientation::Fix).
+    let mut inverted = good.clone();
+    for s in [1, n - 2] {
+        inverted.swap(s * 3 + 1, s * 3 + 2);
+    }
+    for threads in [1, 2, 4] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("thread pool");
+        let err = pool
+            .install(|| SimplexMesh::new(vertices.clone(), bad.clone(), Orientation::Fix))
+            .unwrap_err();
+        assert_eq!(
+            err,
+            MeshError::VertexIndexOutOfRange {
+                simplex: early,
+                local: 2,
+                index: vertices.len() as u32 + 3,
+                vertex_count: vertices.len(),
+            },
+            "{threads} threads"
+        );
+        let fixed = pool
+            .install(|| SimplexMesh::new(vertices.clone(), inverted.clone(), Orientation::Fix))
+            .expect("inverted simplices are fixed");
+        assert!((0..n).all(|s| fixed.volume(s) > 0.0));
+        assert_eq!(fixed.total_volume(), mesh.total_volume());
+        let rejected = pool
+            .install(|| SimplexMesh::new(vertices.clone(), inverted.clone(), Orientation::Reject))
+            .unwrap_err();
+        assert!(
+            matches!(rejected, MeshError::InvertedSimplex { simplex: 1, .. }),
+            "{rejected}"
+        );
+    }
+}
