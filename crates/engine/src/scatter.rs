@@ -111,6 +111,10 @@ pub(crate) struct NodalSums<'a, const D: usize> {
     /// (a block's window reaches it now, or reached it in the last step, whose values
     /// must be cleared). Written by [`Scatter::scatter`].
     pub live: &'a mut [bool],
+    /// Only mass, |N|-mass and momentum are scattered (MLS-MPM, whose momentum carries
+    /// the force): the stiffness and force arrays are neither cleared nor summed, and
+    /// stay as they are (zero, as no step of such a simulation writes them).
+    pub momentum_only: bool,
 }
 
 /// Nodes per chunk of the merge and of the grid update (fixed, so that sums taken per
@@ -240,6 +244,35 @@ impl<const D: usize> Scatter<D> {
         }
         let live: &[bool] = sums.live;
         let windows = &self.windows[..blocks];
+        if sums.momentum_only {
+            sums.mass
+                .par_chunks_mut(NODE_CHUNK)
+                .zip(sums.abs_mass.par_chunks_mut(NODE_CHUNK))
+                .zip(sums.momentum.par_chunks_mut(NODE_CHUNK))
+                .enumerate()
+                .for_each(|(c, ((mass, abs_mass), momentum))| {
+                    if !live[c] {
+                        return;
+                    }
+                    mass.fill(0.0);
+                    abs_mass.fill(0.0);
+                    momentum.fill(SVector::zeros());
+                    let start = c * NODE_CHUNK;
+                    let end = start + mass.len();
+                    // In block order, so each node's sum has the same order on any threads.
+                    for w in windows {
+                        let (from, to) = (w.lo.max(start), w.hi().min(end));
+                        for node in from..to {
+                            let (k, j) = (node - w.lo, node - start);
+                            let sums = &w.sums[k];
+                            mass[j] += sums.mass;
+                            abs_mass[j] += sums.abs_mass;
+                            momentum[j] += sums.momentum;
+                        }
+                    }
+                });
+            return Ok(());
+        }
         sums.mass
             .par_chunks_mut(NODE_CHUNK)
             .zip(sums.abs_mass.par_chunks_mut(NODE_CHUNK))

@@ -98,6 +98,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             momentum: &mut g.momentum,
             force: &mut g.force,
             live: &mut g.live,
+            momentum_only: T::FUSED_FORCE,
         };
         // With a constant second moment (B-splines) the affine energy cannot grow as a
         // particle moves, and the limiter has nothing to do.
