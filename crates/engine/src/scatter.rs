@@ -46,22 +46,49 @@ impl<const D: usize> NodeSums<D> {
     };
 }
 
-/// One block's share of the nodal sums, over nodes `lo..lo + len`.
+/// One node's sums in a window of a momentum-only scatter (MLS-MPM): 40 bytes in 3D
+/// instead of 72, so the window's clearing, the entries and the merge move less memory.
+#[derive(Debug, Clone, Copy)]
+struct MomentumSums<const D: usize> {
+    mass: f64,
+    abs_mass: f64,
+    momentum: SVector<f64, D>,
+}
+
+impl<const D: usize> MomentumSums<D> {
+    const ZERO: Self = Self {
+        mass: 0.0,
+        abs_mass: 0.0,
+        momentum: SVector::from_array_storage(nalgebra::ArrayStorage([[0.0; D]; 1])),
+    };
+}
+
+/// One block's share of the nodal sums, over nodes `lo..hi`: full records, or
+/// momentum-only ones (the other vector is then empty).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Window<const D: usize> {
     lo: usize,
+    hi: usize,
     sums: Vec<NodeSums<D>>,
+    momentum_sums: Vec<MomentumSums<D>>,
 }
 
 impl<const D: usize> Window<D> {
-    fn reset(&mut self, lo: usize, hi: usize) {
+    fn reset(&mut self, lo: usize, hi: usize, momentum_only: bool) {
+        let len = hi.saturating_sub(lo);
         self.lo = lo;
+        self.hi = lo + len;
         self.sums.clear();
-        self.sums.resize(hi.saturating_sub(lo), NodeSums::ZERO);
+        self.momentum_sums.clear();
+        if momentum_only {
+            self.momentum_sums.resize(len, MomentumSums::ZERO);
+        } else {
+            self.sums.resize(len, NodeSums::ZERO);
+        }
     }
 
     fn hi(&self) -> usize {
-        self.lo + self.sums.len()
+        self.hi
     }
 
     /// Adds one stencil entry's contributions to `node`.
@@ -93,7 +120,7 @@ impl<const D: usize> Window<D> {
         abs_mass: f64,
         momentum: SVector<f64, D>,
     ) {
-        let sums = &mut self.sums[node - self.lo];
+        let sums = &mut self.momentum_sums[node - self.lo];
         sums.mass += mass;
         sums.abs_mass += abs_mass;
         sums.momentum += momentum;
@@ -140,7 +167,11 @@ impl<const D: usize> Scatter<D> {
     /// their windows (grows with the nodes).
     pub fn bytes(&self) -> (usize, usize) {
         use crate::memory::bytes;
-        let windows: usize = self.windows.iter().map(|w| bytes(&w.sums)).sum();
+        let windows: usize = self
+            .windows
+            .iter()
+            .map(|w| bytes(&w.sums) + bytes(&w.momentum_sums))
+            .sum();
         (
             bytes(&self.keys) + bytes(&self.order),
             windows
@@ -218,6 +249,7 @@ impl<const D: usize> Scatter<D> {
         E: Send,
     {
         let nodes = sums.mass.len();
+        let momentum_only = sums.momentum_only;
         self.plan(ranges, nodes);
         let blocks = self.bounds.len() - 1;
         self.windows.resize_with(blocks, Window::default);
@@ -227,7 +259,7 @@ impl<const D: usize> Scatter<D> {
             .enumerate()
             .map(|(b, window)| {
                 let (lo, hi) = block_ranges[b];
-                window.reset(lo, hi);
+                window.reset(lo, hi, momentum_only);
                 contribute(&order[bounds[b]..bounds[b + 1]], window)
             })
             .reduce(|| Ok(()), |a, b| lowest_failure(a, b, |(), ()| ()))?;
@@ -264,7 +296,7 @@ impl<const D: usize> Scatter<D> {
                         let (from, to) = (w.lo.max(start), w.hi().min(end));
                         for node in from..to {
                             let (k, j) = (node - w.lo, node - start);
-                            let sums = &w.sums[k];
+                            let sums = &w.momentum_sums[k];
                             mass[j] += sums.mass;
                             abs_mass[j] += sums.abs_mass;
                             momentum[j] += sums.momentum;
