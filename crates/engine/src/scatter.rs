@@ -291,17 +291,12 @@ impl<const D: usize> Scatter<D> {
                     momentum.fill(SVector::zeros());
                     let start = c * NODE_CHUNK;
                     let end = start + mass.len();
-                    // In block order, so each node's sum has the same order on any threads.
-                    for w in windows {
-                        let (from, to) = (w.lo.max(start), w.hi().min(end));
-                        for node in from..to {
-                            let (k, j) = (node - w.lo, node - start);
-                            let sums = &w.momentum_sums[k];
-                            mass[j] += sums.mass;
-                            abs_mass[j] += sums.abs_mass;
-                            momentum[j] += sums.momentum;
-                        }
-                    }
+                    for_each_covered(windows, start, end, |j, k, w| {
+                        let sums = &w.momentum_sums[k];
+                        mass[j] += sums.mass;
+                        abs_mass[j] += sums.abs_mass;
+                        momentum[j] += sums.momentum;
+                    });
                 });
             return Ok(());
         }
@@ -323,20 +318,32 @@ impl<const D: usize> Scatter<D> {
                 force.fill(SVector::zeros());
                 let start = c * NODE_CHUNK;
                 let end = start + mass.len();
-                // In block order, so each node's sum has the same order on any threads.
-                for w in windows {
-                    let (from, to) = (w.lo.max(start), w.hi().min(end));
-                    for node in from..to {
-                        let (k, j) = (node - w.lo, node - start);
-                        let sums = &w.sums[k];
-                        mass[j] += sums.mass;
-                        abs_mass[j] += sums.abs_mass;
-                        stiffness[j] += sums.stiffness;
-                        momentum[j] += sums.momentum;
-                        force[j] += sums.force;
-                    }
-                }
+                for_each_covered(windows, start, end, |j, k, w| {
+                    let sums = &w.sums[k];
+                    mass[j] += sums.mass;
+                    abs_mass[j] += sums.abs_mass;
+                    stiffness[j] += sums.stiffness;
+                    momentum[j] += sums.momentum;
+                    force[j] += sums.force;
+                });
             });
         Ok(())
+    }
+}
+
+/// Calls `add(j, k, window)` for every node `start + j` of `start..end` a window covers
+/// (`k` its index in the window), window by window in block order, so that each node's
+/// sum runs in the same order on any number of threads.
+#[inline(always)]
+fn for_each_covered<const D: usize>(
+    windows: &[Window<D>],
+    start: usize,
+    end: usize,
+    mut add: impl FnMut(usize, usize, &Window<D>),
+) {
+    for w in windows {
+        for node in w.lo.max(start)..w.hi().min(end) {
+            add(node - start, node - w.lo, w);
+        }
     }
 }

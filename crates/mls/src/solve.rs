@@ -106,14 +106,7 @@ pub fn shape_functions<const D: usize, const N: usize, B: PolynomialBasis<D, N>>
             capacity: MAX_STENCIL,
         });
     }
-    if !(scale.is_finite() && scale > 0.0) {
-        return Err(MlsError::InvalidParameter {
-            parameter: "scale",
-            value: scale,
-            reason: "must be finite and positive",
-        });
-    }
-    let inv_scale = 1.0 / scale;
+    let inv_scale = inverse_scale(scale)?;
     let basis = |v: usize| B::evaluate(&((samples.positions[v] - x) * inv_scale));
 
     out.len = n;
@@ -262,4 +255,17 @@ fn invert<const N: usize>(
 /// Maximum absolute column sum.
 fn one_norm<const N: usize>(m: &SMatrix<f64, N, N>) -> f64 {
     m.column_iter().map(|c| c.abs().sum()).fold(0.0, f64::max)
+}
+
+/// 1 / `scale`, the factor the offsets are scaled by, after checking `scale` is a
+/// usable length.
+pub(crate) fn inverse_scale(scale: f64) -> Result<f64, MlsError> {
+    if !(scale.is_finite() && scale > 0.0) {
+        return Err(MlsError::InvalidParameter {
+            parameter: "scale",
+            value: scale,
+            reason: "must be finite and positive",
+        });
+    }
+    Ok(1.0 / scale)
 }

@@ -332,15 +332,7 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
         values: &mut [f64],
         gradients: &mut [SVector<f64, D>],
     ) -> Result<f64, MlsError> {
-        let scale = self.scale(mesh, host);
-        if !(scale.is_finite() && scale > 0.0) {
-            return Err(MlsError::InvalidParameter {
-                parameter: "scale",
-                value: scale,
-                reason: "must be finite and positive",
-            });
-        }
-        let inv_scale = 1.0 / scale;
+        let inv_scale = crate::solve::inverse_scale(self.scale(mesh, host))?;
         let ring = mesh.topology().one_ring(host as usize);
         for ((((&v, &mask), node), value), xi) in ring
             .vertices
