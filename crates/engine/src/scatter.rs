@@ -91,7 +91,8 @@ impl<const D: usize> Window<D> {
         self.hi
     }
 
-    /// Adds one stencil entry's contributions to `node`.
+    /// Adds one stencil entry's contributions to `node`, in a window of a full scatter
+    /// ([`NodalSums::momentum_only`] false).
     #[inline]
     pub fn add(
         &mut self,
@@ -110,8 +111,9 @@ impl<const D: usize> Window<D> {
         sums.force += force;
     }
 
-    /// Adds one stencil entry's mass and momentum to `node` (MLS-MPM, whose momentum
-    /// carries the force impulse: no separate force or stiffness).
+    /// Adds one stencil entry's mass and momentum to `node`, in a window of a
+    /// momentum-only scatter (MLS-MPM, whose momentum carries the force impulse: no
+    /// separate force or stiffness).
     #[inline]
     pub fn add_momentum(
         &mut self,
