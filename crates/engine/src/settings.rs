@@ -41,16 +41,23 @@ pub enum Damping {
     },
 }
 
-/// Whether the step stores every particle's stencil or evaluates it again where P2G and
-/// G2P use it. Both give the same numbers, bit for bit; they trade memory against work.
+/// Whether the step stores every particle's stencil (its entries, or the kernel's
+/// factors of it) or evaluates it again where P2G and G2P use it. All give the same
+/// numbers, bit for bit; they trade memory against work.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum StencilStorage {
-    /// As the kernel prefers (`Kernel::recompute_stencils`): B-splines recompute, mesh
-    /// kernels store.
+    /// As the kernel prefers: recomputed where `Kernel::recompute_stencils` says so
+    /// (B-splines), else stored entries (mesh kernels).
     #[default]
     KernelChoice,
-    /// Store them for the step (memory: ≈ (4 + 8 + 8·D) bytes per stencil entry).
+    /// Store the entries for the step (memory: ≈ (4 + 8 + 8·D) bytes per entry).
     Store,
+    /// Store the kernel's factors for the step where it has them
+    /// (`Kernel::factor_layout`; UMLS with the reconstructed gradient: 8 bytes per entry
+    /// and (D + 1)² + 1 numbers per particle), rebuilding the entries in P2G and G2P;
+    /// the entries where it has none. About half the stored bytes of UMLS in 3D for
+    /// 10–14 % more time per step (docs/scenes.md).
+    Factored,
     /// Evaluate them in P2G and G2P (three evaluations a step with the ordering pass).
     Recompute,
 }

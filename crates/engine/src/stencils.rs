@@ -1,13 +1,13 @@
-//! Stage 1 of the step: every particle's stencil, either stored for the step or
-//! recomputed where P2G and G2P use it ([`StencilStorage`]), with each particle's node
-//! range, which orders the P2G scatter.
+//! Stage 1 of the step: every particle's stencil, stored for the step as entries or as
+//! the kernel's factors, or recomputed where P2G and G2P use it ([`StencilStorage`]),
+//! with each particle's node range, which orders the P2G scatter.
 //!
 //! Computed in parallel over fixed chunks, so the result does not depend on the number
 //! of threads; the buffers are reused from step to step.
 
 use nalgebra::SVector;
 use rayon::prelude::*;
-use umls_transfer::{Kernel, KernelError, Stencil};
+use umls_transfer::{FactorLayout, Kernel, KernelError, Stencil};
 
 use crate::parallel::lowest_failure;
 use crate::settings::StencilStorage;
@@ -17,17 +17,56 @@ use crate::settings::StencilStorage;
 pub(crate) const CHUNK: usize = 512;
 
 /// The stored stencils of one chunk of [`CHUNK`] particles: particle k of the chunk owns
-/// entries `offsets[k]..offsets[k + 1]`. Each chunk keeps its vectors between steps, so
-/// once they have grown a step allocates nothing, and no serial pass copies chunks into
-/// one array.
+/// entries `offsets[k]..offsets[k + 1]` (of the entry arrays, or of `entry_factors`) and
+/// per-particle factors `k·n..(k + 1)·n` with n = [`FactorLayout::per_particle`]. Each
+/// chunk keeps its vectors between steps, so once they have grown a step allocates
+/// nothing, and no serial pass copies chunks into one array.
 #[derive(Debug, Clone, Default)]
 struct ChunkStencils<const D: usize> {
     offsets: Vec<usize>,
     nodes: Vec<u32>,
     values: Vec<f64>,
     gradients: Vec<SVector<f64, D>>,
+    particle_factors: Vec<f64>,
+    entry_factors: Vec<f64>,
     /// The kernel writes here before the entries are appended (or only the range read).
     scratch: Stencil<D>,
+}
+
+impl<const D: usize> ChunkStencils<D> {
+    /// Empties the arrays for a step of `mode`, giving back those it does not use (what
+    /// an earlier step of another mode held).
+    fn clear_for(&mut self, mode: Mode) {
+        let entries = mode == Mode::Entries;
+        let factors = matches!(mode, Mode::Factored(_));
+        clear_or_release(&mut self.nodes, entries);
+        clear_or_release(&mut self.values, entries);
+        clear_or_release(&mut self.gradients, entries);
+        clear_or_release(&mut self.particle_factors, factors);
+        clear_or_release(&mut self.entry_factors, factors);
+        clear_or_release(&mut self.offsets, mode != Mode::Recompute);
+    }
+}
+
+/// Empties `v`, keeping its storage if it is `used`.
+fn clear_or_release<T>(v: &mut Vec<T>, used: bool) {
+    if used {
+        v.clear();
+    } else {
+        *v = Vec::new();
+    }
+}
+
+/// How this step's stencils are kept.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+enum Mode {
+    /// Node, N and ∇N of every entry.
+    #[default]
+    Entries,
+    /// The kernel's factors ([`Kernel::factor_stencil`]).
+    Factored(FactorLayout),
+    /// Nothing but the node ranges: evaluated where used.
+    Recompute,
 }
 
 /// One particle's stencil: node indices, shape-function values and gradients, and the
@@ -70,19 +109,19 @@ pub(crate) trait EntrySink<const D: usize> {
     fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, offset: &SVector<f64, D>);
 }
 
-/// The stencils of all particles (stored by chunk, or to be recomputed) and their node
-/// ranges.
+/// The stencils of all particles (stored by chunk as entries or factors, or to be
+/// recomputed) and their node ranges.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Stencils<const D: usize> {
-    stored: bool,
+    mode: Mode,
     chunks: Vec<ChunkStencils<D>>,
     ranges: Vec<(u32, u32)>,
 }
 
 impl<const D: usize> Stencils<D> {
-    /// Locates every particle (updating its cache) and stores its stencil, or with
-    /// recomputed stencils only its node range. Among failures the lowest particle index
-    /// is reported, whatever the thread count.
+    /// Locates every particle (updating its cache) and stores its stencil (entries or
+    /// factors), or with recomputed stencils only its node range. Among failures the
+    /// lowest particle index is reported, whatever the thread count.
     pub fn compute<K: Kernel<D>>(
         &mut self,
         kernel: &K,
@@ -90,12 +129,15 @@ impl<const D: usize> Stencils<D> {
         positions: &[SVector<f64, D>],
         caches: &mut [K::Cache],
     ) -> Result<(), (usize, KernelError)> {
-        self.stored = match storage {
-            StencilStorage::KernelChoice => !kernel.recompute_stencils(),
-            StencilStorage::Store => true,
-            StencilStorage::Recompute => false,
+        self.mode = match storage {
+            StencilStorage::KernelChoice if kernel.recompute_stencils() => Mode::Recompute,
+            StencilStorage::KernelChoice | StencilStorage::Store => Mode::Entries,
+            StencilStorage::Factored => {
+                kernel.factor_layout().map_or(Mode::Entries, Mode::Factored)
+            }
+            StencilStorage::Recompute => Mode::Recompute,
         };
-        let stored = self.stored;
+        let mode = self.mode;
         self.chunks
             .resize_with(positions.len().div_ceil(CHUNK), ChunkStencils::default);
         self.ranges.resize(positions.len(), (0, 0));
@@ -107,36 +149,56 @@ impl<const D: usize> Stencils<D> {
             .enumerate()
             .map(
                 |(c, (((local, xs), cs), ranges))| -> Result<(), (usize, KernelError)> {
-                    if !stored && local.nodes.capacity() > 0 {
-                        // Give back what an earlier stored step held (the scratch stays).
-                        let scratch = std::mem::take(&mut local.scratch);
-                        *local = ChunkStencils {
-                            scratch,
-                            ..ChunkStencils::default()
-                        };
+                    local.clear_for(mode);
+                    if let Mode::Factored(layout) = mode {
+                        local
+                            .particle_factors
+                            .resize(xs.len() * layout.per_particle, 0.0);
                     }
-                    local.offsets.clear();
-                    local.nodes.clear();
-                    local.values.clear();
-                    local.gradients.clear();
-                    let st = &mut local.scratch;
+                    let ChunkStencils {
+                        offsets,
+                        nodes,
+                        values,
+                        gradients,
+                        particle_factors,
+                        entry_factors,
+                        scratch: st,
+                    } = local;
                     for (i, ((x, cache), range)) in
                         xs.iter().zip(cs.iter_mut()).zip(ranges).enumerate()
                     {
                         let fail = |e| (c * CHUNK + i, e);
-                        if !stored {
-                            *range = kernel.node_range(x, cache, st).map_err(fail)?;
-                            continue;
+                        match mode {
+                            Mode::Recompute => {
+                                *range = kernel.node_range(x, cache, st).map_err(fail)?;
+                            }
+                            Mode::Factored(layout) => {
+                                let n = layout.per_particle;
+                                offsets.push(entry_factors.len());
+                                *range = kernel
+                                    .factor_stencil(
+                                        x,
+                                        cache,
+                                        st,
+                                        &mut particle_factors[i * n..(i + 1) * n],
+                                        entry_factors,
+                                    )
+                                    .map_err(fail)?;
+                            }
+                            Mode::Entries => {
+                                kernel.stencil(x, cache, st).map_err(fail)?;
+                                *range = st.node_range().unwrap_or((0, 0));
+                                offsets.push(nodes.len());
+                                nodes.extend_from_slice(st.nodes());
+                                values.extend_from_slice(st.values());
+                                gradients.extend_from_slice(st.gradients());
+                            }
                         }
-                        kernel.stencil(x, cache, st).map_err(fail)?;
-                        *range = st.node_range().unwrap_or((0, 0));
-                        local.offsets.push(local.nodes.len());
-                        local.nodes.extend_from_slice(st.nodes());
-                        local.values.extend_from_slice(st.values());
-                        local.gradients.extend_from_slice(st.gradients());
                     }
-                    if stored {
-                        local.offsets.push(local.nodes.len());
+                    match mode {
+                        Mode::Factored(_) => offsets.push(entry_factors.len()),
+                        Mode::Entries => offsets.push(nodes.len()),
+                        Mode::Recompute => {}
                     }
                     Ok(())
                 },
@@ -144,13 +206,20 @@ impl<const D: usize> Stencils<D> {
             .reduce(|| Ok(()), |a, b| lowest_failure(a, b, |(), ()| ()))
     }
 
-    /// Bytes of the stored stencils, and of the node ranges.
+    /// Bytes of the stored stencils (entries or factors), and of the node ranges.
     pub fn bytes(&self) -> (usize, usize) {
         use crate::memory::bytes;
         let stored = self
             .chunks
             .iter()
-            .map(|c| bytes(&c.offsets) + bytes(&c.nodes) + bytes(&c.values) + bytes(&c.gradients))
+            .map(|c| {
+                bytes(&c.offsets)
+                    + bytes(&c.nodes)
+                    + bytes(&c.values)
+                    + bytes(&c.gradients)
+                    + bytes(&c.particle_factors)
+                    + bytes(&c.entry_factors)
+            })
             .sum();
         (stored, bytes(&self.ranges))
     }
@@ -160,19 +229,44 @@ impl<const D: usize> Stencils<D> {
         &self.ranges
     }
 
-    /// The chunk holding particle `p`'s stored stencil, and its entries' range there.
+    /// The chunk holding particle `p`'s stored stencil, its index there, and its entries'
+    /// range there.
     #[inline(always)]
-    fn stored_entries(&self, p: usize) -> (&ChunkStencils<D>, std::ops::Range<usize>) {
+    fn stored_entries(&self, p: usize) -> (&ChunkStencils<D>, usize, std::ops::Range<usize>) {
         let chunk = &self.chunks[p / CHUNK];
         let k = p % CHUNK;
-        (chunk, chunk.offsets[k]..chunk.offsets[k + 1])
+        (chunk, k, chunk.offsets[k]..chunk.offsets[k + 1])
     }
 
-    /// Hands every entry of particle `p`'s stencil to `sink`: the stored one, or the
-    /// kernel's [`Kernel::visit_stencil`] at `x` from `cache` (same entries, same bits,
-    /// and for a closed-form kernel no arrays written and read back). Stored stencils
-    /// have no offsets: with `offsets` they are recomputed from the node positions,
-    /// without it zeros are passed.
+    /// Hands every entry of particle `p`'s factored stencil to `visit`.
+    #[inline(always)]
+    fn visit_factored<K: Kernel<D>>(
+        &self,
+        p: usize,
+        layout: FactorLayout,
+        kernel: &K,
+        x: &SVector<f64, D>,
+        cache: &K::Cache,
+        visit: impl FnMut(u32, f64, &SVector<f64, D>, &SVector<f64, D>),
+    ) -> Result<(), (usize, KernelError)> {
+        let (chunk, k, range) = self.stored_entries(p);
+        let n = layout.per_particle;
+        kernel
+            .visit_factored(
+                x,
+                cache,
+                &chunk.particle_factors[k * n..(k + 1) * n],
+                &chunk.entry_factors[range],
+                visit,
+            )
+            .map_err(|e| (p, e))
+    }
+
+    /// Hands every entry of particle `p`'s stencil to `sink`: the stored one, rebuilt
+    /// from its factors, or the kernel's [`Kernel::visit_stencil`] at `x` from `cache`
+    /// (same entries, same bits, and for a closed-form kernel no arrays written and read
+    /// back). Stored entries have no offsets: with `offsets` they are recomputed from
+    /// the node positions, without it zeros are passed.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub fn visit<K: Kernel<D>, S: EntrySink<D>>(
@@ -185,32 +279,51 @@ impl<const D: usize> Stencils<D> {
         offsets: bool,
         sink: &mut S,
     ) -> Result<(), (usize, KernelError)> {
-        if self.stored {
-            let (chunk, range) = self.stored_entries(p);
-            for e in range {
-                let node = chunk.nodes[e];
-                let offset = if offsets {
-                    kernel.node_position(node as usize) - x
-                } else {
-                    SVector::zeros()
-                };
-                sink.entry(node, chunk.values[e], &chunk.gradients[e], &offset);
+        match self.mode {
+            Mode::Entries => {
+                let (chunk, _, range) = self.stored_entries(p);
+                for e in range {
+                    let node = chunk.nodes[e];
+                    let offset = if offsets {
+                        kernel.node_position(node as usize) - x
+                    } else {
+                        SVector::zeros()
+                    };
+                    sink.entry(node, chunk.values[e], &chunk.gradients[e], &offset);
+                }
+                Ok(())
             }
-            return Ok(());
+            Mode::Factored(layout) => {
+                // Inlined by force: left to itself the compiler keeps the sink's entry a
+                // call per rebuilt entry, with the sums in memory.
+                self.visit_factored(
+                    p,
+                    layout,
+                    kernel,
+                    x,
+                    cache,
+                    #[inline(always)]
+                    |node, n, gradient, offset| sink.entry(node, n, gradient, offset),
+                )
+            }
+            Mode::Recompute => {
+                let mut cache = *cache;
+                // A closure with this one call site, so the kernel's loop inlines it (a
+                // closure called from two places stays a call, and its sums leave the
+                // registers).
+                kernel
+                    .visit_stencil(x, &mut cache, scratch, |node, n, gradient, offset| {
+                        sink.entry(node, n, gradient, offset)
+                    })
+                    .map_err(|e| (p, e))
+            }
         }
-        let mut cache = *cache;
-        // A closure with this one call site, so the kernel's loop inlines it (a closure
-        // called from two places stays a call, and its sums leave the registers).
-        kernel
-            .visit_stencil(x, &mut cache, scratch, |node, n, gradient, offset| {
-                sink.entry(node, n, gradient, offset)
-            })
-            .map_err(|e| (p, e))
     }
 
-    /// Calls `f` with particle `p`'s stencil: the stored one, or evaluated into `scratch`
-    /// at `x` from `cache` (the particle's position and location of this step, which
-    /// give the same stencil as [`Self::compute`] evaluated, bit for bit).
+    /// Calls `f` with particle `p`'s stencil: the stored entries, or the entries rebuilt
+    /// from the stored factors or evaluated into `scratch` at `x` from `cache` (the
+    /// particle's position and location of this step, which give the same stencil as
+    /// [`Self::compute`] evaluated, bit for bit).
     #[inline]
     pub fn with<K: Kernel<D>, R>(
         &self,
@@ -221,17 +334,33 @@ impl<const D: usize> Stencils<D> {
         scratch: &mut Stencil<D>,
         f: impl FnOnce(ParticleStencil<'_, D>) -> R,
     ) -> Result<R, (usize, KernelError)> {
-        if self.stored {
-            let (chunk, range) = self.stored_entries(p);
-            return Ok(f(ParticleStencil {
-                nodes: &chunk.nodes[range.clone()],
-                values: &chunk.values[range.clone()],
-                gradients: &chunk.gradients[range],
-                offsets: &[],
-            }));
+        match self.mode {
+            Mode::Entries => {
+                let (chunk, _, range) = self.stored_entries(p);
+                return Ok(f(ParticleStencil {
+                    nodes: &chunk.nodes[range.clone()],
+                    values: &chunk.values[range.clone()],
+                    gradients: &chunk.gradients[range],
+                    offsets: &[],
+                }));
+            }
+            Mode::Factored(layout) => {
+                scratch.clear();
+                self.visit_factored(
+                    p,
+                    layout,
+                    kernel,
+                    x,
+                    cache,
+                    #[inline(always)]
+                    |node, n, gradient, offset| scratch.push(node, n, *gradient, *offset),
+                )?;
+            }
+            Mode::Recompute => {
+                let mut cache = *cache;
+                kernel.stencil(x, &mut cache, scratch).map_err(|e| (p, e))?;
+            }
         }
-        let mut cache = *cache;
-        kernel.stencil(x, &mut cache, scratch).map_err(|e| (p, e))?;
         Ok(f(ParticleStencil {
             nodes: scratch.nodes(),
             values: scratch.values(),

@@ -220,17 +220,21 @@ fn three_dimensional_runs_are_bitwise_independent_of_the_thread_count() {
     assert_thread_independent("bspline3 3D", grid, 0.0195, 5, true);
 }
 
-/// Recomputing a stencil where P2G and G2P use it gives the stored stencil's numbers, bit
-/// for bit (APIC reads the offsets x_i − x_p too), for grid and mesh kernels, with
-/// either storage on 1 and 2 threads.
+/// Recomputing a stencil where P2G and G2P use it, or rebuilding it from stored factors
+/// (UMLS; the others store entries then), gives the stored stencil's numbers, bit for bit
+/// (APIC reads the offsets x_i − x_p too), for grid and mesh kernels, on 1 and 2 threads.
 #[test]
-fn stored_and_recomputed_stencils_give_the_same_bits() {
+fn stored_factored_and_recomputed_stencils_give_the_same_bits() {
     fn same<const D: usize, K: Kernel<D> + Clone + Send + Sync>(name: &str, kernel: K, h: f64) {
         let stored = state(&kernel, h, 12, 1, StencilStorage::Store);
         for threads in [1, 2] {
             assert!(
                 state(&kernel, h, 12, threads, StencilStorage::Recompute) == stored,
                 "{name}: recomputed stencils on {threads} threads differ from stored ones"
+            );
+            assert!(
+                state(&kernel, h, 12, threads, StencilStorage::Factored) == stored,
+                "{name}: factored stencils on {threads} threads differ from stored ones"
             );
         }
         // The runs moved the particles: the comparison is not between two rest states.
@@ -251,9 +255,18 @@ fn stored_and_recomputed_stencils_give_the_same_bits() {
     );
     same("bspline3 3D", grid3.unwrap(), 0.05);
     let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [16, 16]).jitter(0.2, 5);
+    let triangles = Arc::new(mesh.triangles(Diagonal::Alternating).unwrap());
+    assert!(Umls2::new(triangles.clone()).factor_layout().is_some());
+    same("umls", Umls2::new(triangles.clone()), 0.0125);
     same(
-        "umls",
-        Umls2::new(Arc::new(mesh.triangles(Diagonal::Alternating).unwrap())),
+        "umls full gradient (entries)",
+        Umls2::new(triangles).with_gradient(umls_mls::GradientKind::Full),
         0.0125,
+    );
+    let tets = Lattice::new([0.0; 3], [1.0; 3], [6; 3]).jitter(0.2, 3);
+    same(
+        "umls 3D",
+        Umls3::new(Arc::new(tets.tetrahedra().unwrap())),
+        0.05,
     );
 }

@@ -1,7 +1,8 @@
 //! What a simulation holds per particle, from its own accounting
 //! (`Simulation::memory_use`): the particle state plus a step's per-particle scratch stays
 //! within 400 bytes for quadratic B-splines in 3D (stencils recomputed where used) and
-//! 600 bytes for UMLS with recomputed stencils; stored stencils add their entries.
+//! 600 bytes for UMLS with recomputed stencils; stored stencils add their entries, or
+//! about a quarter of that as UMLS factors.
 
 use std::sync::Arc;
 
@@ -66,10 +67,21 @@ fn umls_particles_stay_within_600_bytes_with_recomputed_stencils() {
     assert_eq!(recomputed.stencils, 0);
     let per_particle = recomputed.bytes_per_particle();
     assert!(per_particle <= 600.0, "{per_particle} B per particle");
-    let stored = memory(Umls3::new(mesh), 0.025, StencilStorage::KernelChoice);
-    assert!(stored.stencils > 0, "mesh kernels store by default");
+    let stored = memory(Umls3::new(mesh.clone()), 0.025, StencilStorage::Store);
+    assert!(stored.stencils > 0);
     // A stored UMLS stencil has tens of entries of 36 B.
     let stencil = stored.stencils as f64 / stored.particle_count as f64;
     assert!((10.0 * 36.0..64.0 * 36.0).contains(&stencil), "{stencil} B");
     assert!(stored.bytes_per_particle_with_stencils() > per_particle + 10.0 * 36.0);
+    // Factored: 8 B per entry (10 to 64 of them), M⁻¹ (16 numbers) and 1/s per particle,
+    // and 8 B of offset, in vectors that grow by doubling.
+    let factored = memory(Umls3::new(mesh), 0.025, StencilStorage::Factored);
+    let got = factored.stencils as f64 / factored.particle_count as f64;
+    let per_particle = 17.0 * 8.0 + 8.0;
+    assert!(
+        (per_particle + 10.0 * 8.0..2.0 * (per_particle + 64.0 * 8.0)).contains(&got),
+        "{got} B factored"
+    );
+    assert!(got < stencil, "{got} B factored, {stencil} B stored");
+    assert_eq!(factored.particles, stored.particles);
 }

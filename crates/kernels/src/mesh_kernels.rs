@@ -6,8 +6,10 @@ use nalgebra::SVector;
 use std::marker::PhantomData;
 use umls_mesh::{Barycentric, Located, SimplexMesh};
 
-use umls_mls::{CubicBSpline, GradientKind, Linear, PolynomialBasis, UmlsKernel, WeightFunction};
-use umls_transfer::{DomainExit, Kernel, KernelError, Stencil};
+use umls_mls::{
+    CubicBSpline, GradientKind, Linear, PolynomialBasis, UmlsFit, UmlsKernel, WeightFunction,
+};
+use umls_transfer::{DomainExit, FactorLayout, Kernel, KernelError, Stencil};
 
 /// The node methods of a kernel whose nodes are the vertices of `self.mesh`.
 macro_rules! mesh_nodes {
@@ -237,6 +239,77 @@ where
             *offset = self.mesh.vertex(v as usize) - x;
         }
         Ok(())
+    }
+
+    /// With the reconstructed gradient: the fit's M⁻¹ and 1/s per particle and its
+    /// weight per ring vertex ([`UmlsFit`]). The full gradient also needs the weights'
+    /// gradients and is not factored.
+    fn factor_layout(&self) -> Option<FactorLayout> {
+        (self.gradient == GradientKind::Reconstructed).then_some(FactorLayout {
+            per_particle: UmlsFit::<N>::LEN,
+            per_entry: 1,
+        })
+    }
+
+    fn factor_stencil(
+        &self,
+        x: &SVector<f64, D>,
+        cache: &mut HostCache,
+        scratch: &mut Stencil<D>,
+        particle: &mut [f64],
+        entries: &mut Vec<f64>,
+    ) -> Result<(u32, u32), KernelError> {
+        if self.factor_layout().is_none() {
+            return Err(KernelError::NotFactored {
+                kernel: "UMLS with the full gradient",
+            });
+        }
+        let located = locate_with_coordinates(&self.mesh, x, cache)?;
+        let ring = self.mesh.topology().one_ring(located.simplex as usize);
+        let start = entries.len();
+        entries.resize(start + ring.len(), 0.0);
+        let scaled_offsets = scratch.entries_mut(ring.len()).gradients;
+        let fit = self
+            .kernel
+            .fit_into::<N, B>(
+                &self.mesh,
+                &located,
+                x,
+                &mut entries[start..],
+                scaled_offsets,
+            )
+            .and_then(|fit| fit.write(particle));
+        if let Err(e) = fit {
+            entries.truncate(start);
+            return Err(KernelError::evaluation("UMLS", e));
+        }
+        let (low, high) = ring
+            .vertices
+            .iter()
+            .fold((u32::MAX, 0), |(l, h), &v| (l.min(v), h.max(v)));
+        Ok((low, high))
+    }
+
+    #[inline(always)]
+    fn visit_factored<F>(
+        &self,
+        x: &SVector<f64, D>,
+        cache: &HostCache,
+        particle: &[f64],
+        entries: &[f64],
+        visit: F,
+    ) -> Result<(), KernelError>
+    where
+        F: FnMut(u32, f64, &SVector<f64, D>, &SVector<f64, D>),
+    {
+        let host = cache.0.ok_or_else(|| KernelError::OutsideDomain {
+            point: x.iter().copied().collect(),
+        })?;
+        // No closure around `visit` (an `and_then`): it would keep `visit` from being
+        // inlined into the loop, and the caller's sums from staying in registers.
+        let fit = UmlsFit::<N>::read(particle).map_err(|e| KernelError::evaluation("UMLS", e))?;
+        fit.visit::<D, B>(&self.mesh, host, x, entries, visit)
+            .map_err(|e| KernelError::evaluation("UMLS", e))
     }
 }
 

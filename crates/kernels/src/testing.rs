@@ -10,6 +10,9 @@
 //!   to the stencil's smallest and largest node;
 //! - the same stencil from a fresh location cache as from a warm one;
 //! - `Kernel::visit_stencil` handing over the stencil's entries in order, bit for bit;
+//! - factored stencils (`Kernel::factor_layout`) of the declared layout, rebuilt by
+//!   `Kernel::visit_factored` into the stencil's entries, with its node range; and
+//!   `KernelError::NotFactored` from a kernel without a layout;
 //! - a typed `KernelError::OutsideDomain` far outside.
 //!
 //! ```
@@ -131,6 +134,7 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
                 "visit_stencil hands over other entries than stencil gives".into(),
             ));
         }
+        check_factors(kernel, x, &st).map_err(fail)?;
     }
     let outside_error = |what: &str, got: String| Violation {
         point: outside.iter().copied().collect(),
@@ -148,4 +152,53 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
         Err(KernelError::OutsideDomain { .. }) => Ok(()),
         other => Err(outside_error("visit_stencil", format!("{other:?}"))),
     }
+}
+
+/// The factored-stencil checks at `x`, whose stencil is `st`.
+fn check_factors<const D: usize, K: Kernel<D>>(
+    kernel: &K,
+    x: &SVector<f64, D>,
+    st: &Stencil<D>,
+) -> Result<(), String> {
+    let mut cache = K::Cache::default();
+    let mut scratch = Stencil::new();
+    let Some(layout) = kernel.factor_layout() else {
+        let mut entries = Vec::new();
+        return match kernel.factor_stencil(x, &mut cache, &mut scratch, &mut [], &mut entries) {
+            Err(KernelError::NotFactored { .. }) => Ok(()),
+            other => Err(format!(
+                "factor_stencil without a factor layout gives {other:?}, not NotFactored"
+            )),
+        };
+    };
+    let mut particle = vec![0.0; layout.per_particle];
+    // Appended after what is there, as an engine's chunk appends particle after particle.
+    let mut entries = vec![f64::NAN; 3];
+    let range = kernel
+        .factor_stencil(x, &mut cache, &mut scratch, &mut particle, &mut entries)
+        .map_err(|e| format!("factor_stencil fails inside the domain: {e}"))?;
+    if Some(range) != st.node_range() {
+        return Err(format!(
+            "factor_stencil gives the node range {range:?}, the stencil spans {:?}",
+            st.node_range()
+        ));
+    }
+    if entries.len() - 3 != layout.per_entry * st.len() {
+        return Err(format!(
+            "factor_stencil appended {} numbers for {} entries of {} each",
+            entries.len() - 3,
+            st.len(),
+            layout.per_entry
+        ));
+    }
+    let mut rebuilt = Stencil::new();
+    kernel
+        .visit_factored(x, &cache, &particle, &entries[3..], |node, n, g, r| {
+            rebuilt.push(node, n, *g, *r)
+        })
+        .map_err(|e| format!("visit_factored fails inside the domain: {e}"))?;
+    if &rebuilt != st {
+        return Err("visit_factored rebuilds other entries than stencil gives".into());
+    }
+    Ok(())
 }

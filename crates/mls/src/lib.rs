@@ -16,7 +16,9 @@
 //! weight d_v. Shape functions and reconstructed gradients are continuous across facets
 //! (the tests measure the jumps), unlike linear finite-element shape functions.
 //! [`UmlsKernel::evaluate_into`] writes the same values straight into a caller's arrays
-//! of any length (an MPM engine's stencil storage), with no intermediate stencil.
+//! of any length (an MPM engine's stencil storage), with no intermediate stencil;
+//! [`UmlsKernel::fit_into`] keeps the fit as its weights and a [`UmlsFit`] (M⁻¹ and the
+//! scale), from which [`UmlsFit::visit`] rebuilds the same entries later, bit for bit.
 //!
 //! ```
 //! use nalgebra::Vector2;
@@ -47,6 +49,8 @@ mod solve;
 mod stencil;
 #[cfg(feature = "mesh")]
 mod umls;
+#[cfg(feature = "mesh")]
+mod umls_fit;
 mod weight;
 
 pub use basis::{Linear, PolynomialBasis, Quadratic};
@@ -57,4 +61,6 @@ pub use solve::{Conditioning, IllConditionedPolicy, Samples, shape_functions};
 pub use stencil::{GradientKind, MAX_STENCIL, Stencil};
 #[cfg(feature = "mesh")]
 pub use umls::{DEFAULT_SUPPORT_FACTOR, HOST_TOLERANCE, SupportRadius, UmlsKernel};
+#[cfg(feature = "mesh")]
+pub use umls_fit::UmlsFit;
 pub use weight::{CubicBSpline, Profile, WeightFunction, WendlandC2};

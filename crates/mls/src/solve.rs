@@ -162,9 +162,26 @@ pub(crate) fn shape_functions_in_place<const D: usize, const N: usize, B: Polyno
     inv_scale: f64,
     conditioning: &Conditioning,
 ) -> Result<(SMatrix<f64, N, N>, f64), MlsError> {
+    let (inverse, condition) = moment_inverse::<D, N, B>(values, gradients, conditioning)?;
+    let inverse_transpose = inverse.transpose();
+    for (value, gradient) in values.iter_mut().zip(gradients.iter_mut()) {
+        (*value, *gradient) =
+            shape_function::<D, N, B>(&inverse_transpose, inv_scale, *value, gradient);
+    }
+    Ok((inverse, condition))
+}
+
+/// The inverse of the moment matrix M = Σ_v w_v p(ξ_v) p(ξ_v)ᵀ of the weights `weights`
+/// and scaled offsets `scaled_offsets` ξ_v, with the conditioning policy applied, and
+/// its 1-norm condition number.
+pub(crate) fn moment_inverse<const D: usize, const N: usize, B: PolynomialBasis<D, N>>(
+    weights: &[f64],
+    scaled_offsets: &[SVector<f64, D>],
+    conditioning: &Conditioning,
+) -> Result<(SMatrix<f64, N, N>, f64), MlsError> {
     let mut moment = SMatrix::<f64, N, N>::zeros();
     let mut positive = 0;
-    for (v, (&w, xi)) in values.iter().zip(gradients.iter()).enumerate() {
+    for (v, (&w, xi)) in weights.iter().zip(scaled_offsets).enumerate() {
         if !(w.is_finite() && w >= 0.0) {
             return Err(MlsError::InvalidWeight {
                 sample: v,
@@ -188,17 +205,50 @@ pub(crate) fn shape_functions_in_place<const D: usize, const N: usize, B: Polyno
             moment[(i, i)] += shift;
         }
     }
-    let (inverse, condition) = invert(moment, positive, conditioning)?;
-    let a = inverse.column(0).into_owned();
-    for (value, gradient) in values.iter_mut().zip(gradients.iter_mut()) {
-        let w = *value;
-        let p = B::evaluate(gradient);
-        let g = a.dot(&p);
-        *value = w * g;
-        *gradient =
-            SVector::<f64, D>::from_fn(|k, _| w * inverse.column(k + 1).dot(&p) * inv_scale);
+    invert(moment, positive, conditioning)
+}
+
+/// One sample's shape function N_v = w_v (M⁻¹e₀)ᵀ p(ξ_v) and reconstructed gradient
+/// ∇̃_k N_v = w_v (M⁻¹e_{k+1})ᵀ p(ξ_v) / s, from the transposed inverse moment matrix
+/// (M⁻¹)ᵀ, 1/s, the weight and the scaled offset. Every evaluation of a
+/// reconstructed-gradient fit goes through it, so a fit kept as (M⁻¹, w) and evaluated
+/// later gives the same bits.
+#[inline(always)]
+pub(crate) fn shape_function<const D: usize, const N: usize, B: PolynomialBasis<D, N>>(
+    inverse_transpose: &SMatrix<f64, N, N>,
+    inv_scale: f64,
+    weight: f64,
+    scaled_offset: &SVector<f64, D>,
+) -> (f64, SVector<f64, D>) {
+    let p = B::evaluate(scaled_offset);
+    let dots = column_dots::<D, N>(inverse_transpose, &p);
+    let value = weight * dots[0];
+    let gradient = SVector::<f64, D>::from_fn(|k, _| weight * dots[k + 1] * inv_scale);
+    (value, gradient)
+}
+
+/// (M⁻¹e_k)ᵀ p for k = 0..=D (zero beyond), from t = (M⁻¹)ᵀ, whose columns are M⁻¹'s
+/// rows. For N ≤ 4 the sums are nalgebra's `dot` of a column with p, term for term and in
+/// its order ((a + b) + c for three terms, (a + c) + (b + d) for four), but formed lane by
+/// lane over k as sums of t's columns, which vectorises; beyond, the columns' dots.
+#[inline(always)]
+fn column_dots<const D: usize, const N: usize>(
+    t: &SMatrix<f64, N, N>,
+    p: &SVector<f64, N>,
+) -> SVector<f64, N> {
+    let term = |j: usize| t.column(j) * p[j];
+    match N {
+        2 => term(0) + term(1),
+        3 => (term(0) + term(1)) + term(2),
+        4 => (term(0) + term(2)) + (term(1) + term(3)),
+        _ => SVector::from_fn(|k, _| {
+            if k <= D {
+                t.row(k).transpose().dot(p)
+            } else {
+                0.0
+            }
+        }),
     }
-    Ok((inverse, condition))
 }
 
 /// Inverts the SPD moment matrix, estimating κ₁ = ‖M‖₁‖M⁻¹‖₁ and applying the policy.

@@ -8,8 +8,11 @@ use crate::basis::PolynomialBasis;
 use crate::diminishing::{diminishing_factor, diminishing_gradient};
 use crate::error::MlsError;
 use crate::point_cloud::radial_weight;
-use crate::solve::{Conditioning, Samples, shape_functions, shape_functions_in_place};
+use crate::solve::{
+    Conditioning, Samples, moment_inverse, shape_functions, shape_functions_in_place,
+};
 use crate::stencil::{GradientKind, MAX_STENCIL, Stencil};
+use crate::umls_fit::UmlsFit;
 use crate::weight::{CubicBSpline, WeightFunction};
 
 /// How the support radius h_v of each vertex's distance weight d_v = W(|x − x_v| / h_v)
@@ -332,25 +335,84 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
         values: &mut [f64],
         gradients: &mut [SVector<f64, D>],
     ) -> Result<f64, MlsError> {
-        let inv_scale = crate::solve::inverse_scale(self.scale(mesh, host))?;
         let ring = mesh.topology().one_ring(host as usize);
-        for ((((&v, &mask), node), value), xi) in ring
-            .vertices
-            .iter()
-            .zip(ring.masks)
-            .zip(nodes.iter_mut())
-            .zip(values.iter_mut())
-            .zip(gradients.iter_mut())
-        {
-            let xv = mesh.vertex(v as usize);
-            let (d, _) = radial_weight(&self.weight, x, xv, self.radii[v as usize]);
-            *node = v;
-            *value = diminishing_factor(mask, lambda.as_slice()) * d;
-            *xi = (xv - x) * inv_scale;
-        }
+        nodes.copy_from_slice(ring.vertices);
+        let inv_scale = self.ring_weights(mesh, host, x, lambda, values, gradients)?;
         shape_functions_in_place::<D, N, B>(values, gradients, inv_scale, &self.conditioning)
             .map(|(_, condition)| condition)
             .map_err(|e| with_host(e, host))
+    }
+
+    /// The weights w_v = η_v d_v of the host's 1-ring at `x` into `weights`, the scaled
+    /// offsets (x_v − x)/s into `scaled_offsets` (both of the ring's length), and 1/s.
+    fn ring_weights(
+        &self,
+        mesh: &SimplexMesh<D>,
+        host: u32,
+        x: &SVector<f64, D>,
+        lambda: &Barycentric<D>,
+        weights: &mut [f64],
+        scaled_offsets: &mut [SVector<f64, D>],
+    ) -> Result<f64, MlsError> {
+        let inv_scale = crate::solve::inverse_scale(self.scale(mesh, host))?;
+        let ring = mesh.topology().one_ring(host as usize);
+        for (((&v, &mask), weight), xi) in ring
+            .vertices
+            .iter()
+            .zip(ring.masks)
+            .zip(weights.iter_mut())
+            .zip(scaled_offsets.iter_mut())
+        {
+            let xv = mesh.vertex(v as usize);
+            let (d, _) = radial_weight(&self.weight, x, xv, self.radii[v as usize]);
+            *weight = diminishing_factor(mask, lambda.as_slice()) * d;
+            *xi = (xv - x) * inv_scale;
+        }
+        Ok(inv_scale)
+    }
+
+    /// The reconstructed-gradient fit at `x` in factored form: the 1-ring's weights
+    /// into `weights` (the ring's length), and M⁻¹ with 1/s returned, from which
+    /// [`UmlsFit::visit`] rebuilds the entries of [`Self::evaluate_into`] bit for bit.
+    /// `scaled_offsets`, of the ring's length too, is scratch. `located` as for
+    /// [`Self::evaluate_into`]. An engine that stores fits instead of stencils keeps
+    /// N² + 1 numbers per particle and one per ring vertex (the node indices are the
+    /// host's ring).
+    ///
+    /// # Errors
+    /// As [`Self::evaluate_into`]: a host outside the mesh or not holding `x`, slices
+    /// of another length, or a moment matrix the conditioning policy rejects.
+    pub fn fit_into<const N: usize, B: PolynomialBasis<D, N>>(
+        &self,
+        mesh: &SimplexMesh<D>,
+        located: &Located<D>,
+        x: &SVector<f64, D>,
+        weights: &mut [f64],
+        scaled_offsets: &mut [SVector<f64, D>],
+    ) -> Result<UmlsFit<N>, MlsError> {
+        let host = located.simplex;
+        self.check_host(mesh, host)?;
+        let lambda = &located.barycentric;
+        if lambda.min() < -HOST_TOLERANCE {
+            return Err(MlsError::OutsideHost {
+                simplex: host,
+                min_barycentric: lambda.min(),
+            });
+        }
+        let ring = mesh.topology().one_ring(host as usize).len();
+        if weights.len() != ring || scaled_offsets.len() != ring {
+            return Err(MlsError::OutputLength {
+                simplex: host,
+                ring,
+                nodes: ring,
+                values: weights.len(),
+                gradients: scaled_offsets.len(),
+            });
+        }
+        let inv_scale = self.ring_weights(mesh, host, x, lambda, weights, scaled_offsets)?;
+        let (inverse, _) = moment_inverse::<D, N, B>(weights, scaled_offsets, &self.conditioning)
+            .map_err(|e| with_host(e, host))?;
+        Ok(UmlsFit::new(&inverse, inv_scale))
     }
 
     /// Locates `x` (walking from `hint` when given) and evaluates there; returns the host.

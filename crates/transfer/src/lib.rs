@@ -50,6 +50,13 @@ pub enum KernelError {
         /// Coordinates of the point.
         point: Vec<f64>,
     },
+    /// The engine asked for a kernel's factored stencil ([`Kernel::factor_stencil`])
+    /// although the kernel has no [`Kernel::factor_layout`].
+    #[error("{kernel} kernel has no factored stencils")]
+    NotFactored {
+        /// The kernel's name (its type).
+        kernel: &'static str,
+    },
     /// The kernel's own evaluation failed (an MLS moment matrix that is ill-conditioned,
     /// …): the kernel names itself, and the cause is its own error type, which
     /// `std::error::Error::source` and `downcast_ref` reach.
@@ -81,6 +88,7 @@ impl PartialEq for KernelError {
     fn eq(&self, other: &Self) -> bool {
         match (self, other) {
             (Self::OutsideDomain { point: a }, Self::OutsideDomain { point: b }) => a == b,
+            (Self::NotFactored { kernel: a }, Self::NotFactored { kernel: b }) => a == b,
             (
                 Self::Evaluation {
                     kernel: a,
@@ -115,6 +123,16 @@ impl<const D: usize> DomainExit<D> {
     pub fn facet(&self) -> &[u32] {
         &self.facet[..self.facet_len]
     }
+}
+
+/// How many numbers a kernel's factored stencil takes ([`Kernel::factor_layout`]): a
+/// fixed block per particle and one number per stencil entry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FactorLayout {
+    /// `f64`s per particle (an MLS fit's inverse moment matrix and scale).
+    pub per_particle: usize,
+    /// `f64`s per stencil entry (an MLS fit's weight), 0 or 1.
+    pub per_entry: usize,
 }
 
 /// A shape-function kernel over a fixed set of nodes.
@@ -188,6 +206,57 @@ pub trait Kernel<const D: usize>: Send + Sync {
     /// false (store).
     fn recompute_stencils(&self) -> bool {
         false
+    }
+
+    /// Whether the kernel can keep a stencil as factors from which its entries are
+    /// rebuilt cheaply ([`Self::factor_stencil`], [`Self::visit_factored`]), and their
+    /// layout: for an MLS kernel the inverse moment matrix and the weights, a third of
+    /// the entries' bytes, where the fit itself (weights, moment sums, inverse) is most
+    /// of the cost. An engine may store factors instead of entries to save memory, at the
+    /// price of rebuilding each entry where it is used. Default: `None`.
+    fn factor_layout(&self) -> Option<FactorLayout> {
+        None
+    }
+
+    /// Locates `x` (updating `cache`), writes the stencil's per-particle factors into
+    /// `particle` (length [`FactorLayout::per_particle`]) and appends its per-entry
+    /// factors to `entries`; returns the stencil's smallest and largest node. Fails
+    /// exactly where [`Self::stencil`] fails. `scratch` is the kernel's to use. The
+    /// default, for kernels without a [`Self::factor_layout`], fails with
+    /// [`KernelError::NotFactored`].
+    fn factor_stencil(
+        &self,
+        x: &SVector<f64, D>,
+        cache: &mut Self::Cache,
+        scratch: &mut Stencil<D>,
+        particle: &mut [f64],
+        entries: &mut Vec<f64>,
+    ) -> Result<(u32, u32), KernelError> {
+        let _ = (x, cache, scratch, particle, entries);
+        Err(KernelError::NotFactored {
+            kernel: std::any::type_name::<Self>(),
+        })
+    }
+
+    /// Calls `visit(node, N, ∇N, x_node − x)` for every entry of the stencil that
+    /// [`Self::factor_stencil`] factored at `x` with `cache` into `particle` and
+    /// `entries`: the entries of [`Self::stencil`] at `x`, in its order and bit for bit.
+    /// The default fails with [`KernelError::NotFactored`].
+    fn visit_factored<F>(
+        &self,
+        x: &SVector<f64, D>,
+        cache: &Self::Cache,
+        particle: &[f64],
+        entries: &[f64],
+        visit: F,
+    ) -> Result<(), KernelError>
+    where
+        F: FnMut(u32, f64, &SVector<f64, D>, &SVector<f64, D>),
+    {
+        let _ = (x, cache, particle, entries, visit);
+        Err(KernelError::NotFactored {
+            kernel: std::any::type_name::<Self>(),
+        })
     }
 
     /// The second moment Σ_i N_i(x) (x_i − x)(x_i − x)ᵀ where it is the same multiple
