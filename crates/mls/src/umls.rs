@@ -248,16 +248,8 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
         values: &mut [f64],
         gradients: &mut [SVector<f64, D>],
     ) -> Result<f64, MlsError> {
-        let host = located.simplex;
-        self.check_host(mesh, host)?;
+        let (host, ring) = self.check_located(mesh, located)?;
         let lambda = &located.barycentric;
-        if lambda.min() < -HOST_TOLERANCE {
-            return Err(MlsError::OutsideHost {
-                simplex: host,
-                min_barycentric: lambda.min(),
-            });
-        }
-        let ring = mesh.topology().one_ring(host as usize).len();
         if nodes.len() != ring || values.len() != ring || gradients.len() != ring {
             return Err(MlsError::OutputLength {
                 simplex: host,
@@ -276,6 +268,26 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
         values.copy_from_slice(stencil.values());
         gradients.copy_from_slice(stencil.gradients());
         Ok(stencil.condition_number())
+    }
+
+    /// Checks a location as [`Self::evaluate_into`] and [`Self::fit_into`] take it: a host
+    /// of `mesh`, which the kernel was built for, holding the point; returns the host and
+    /// its 1-ring's size.
+    fn check_located(
+        &self,
+        mesh: &SimplexMesh<D>,
+        located: &Located<D>,
+    ) -> Result<(u32, usize), MlsError> {
+        let host = located.simplex;
+        self.check_host(mesh, host)?;
+        let lambda = &located.barycentric;
+        if lambda.min() < -HOST_TOLERANCE {
+            return Err(MlsError::OutsideHost {
+                simplex: host,
+                min_barycentric: lambda.min(),
+            });
+        }
+        Ok((host, mesh.topology().one_ring(host as usize).len()))
     }
 
     /// Checks that `host` is a simplex of `mesh` and that the kernel was built for it.
@@ -390,16 +402,8 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
         weights: &mut [f64],
         scaled_offsets: &mut [SVector<f64, D>],
     ) -> Result<UmlsFit<N>, MlsError> {
-        let host = located.simplex;
-        self.check_host(mesh, host)?;
+        let (host, ring) = self.check_located(mesh, located)?;
         let lambda = &located.barycentric;
-        if lambda.min() < -HOST_TOLERANCE {
-            return Err(MlsError::OutsideHost {
-                simplex: host,
-                min_barycentric: lambda.min(),
-            });
-        }
-        let ring = mesh.topology().one_ring(host as usize).len();
         if weights.len() != ring || scaled_offsets.len() != ring {
             return Err(MlsError::OutputLength {
                 simplex: host,
