@@ -5,7 +5,7 @@
 
 mod common;
 
-use nalgebra::{SVector, Vector2};
+use nalgebra::Vector2;
 use proptest::prelude::*;
 use umls_mesh::{Located, Orientation, SimplexMesh};
 use umls_mls::{
@@ -20,38 +20,17 @@ fn same_as_evaluate<const D: usize, const N: usize, B: PolynomialBasis<D, N>>(
 ) -> Result<(), TestCaseError> {
     let kernel = UmlsKernel::new(mesh);
     let x = common::point_in(mesh, s, raw);
-    let ring = mesh.topology().one_ring(s).len();
     for gradient in [GradientKind::Reconstructed, GradientKind::Full] {
         let mut stencil = Stencil::new();
         let expected = kernel.evaluate::<N, B>(mesh, s as u32, &x, gradient, &mut stencil);
-        let mut nodes = vec![0u32; ring];
-        let mut values = vec![0.0; ring];
-        let mut gradients = vec![SVector::<f64, D>::zeros(); ring];
-        let located = Located {
-            simplex: s as u32,
-            barycentric: mesh.barycentric(s, &x),
-        };
-        let got = kernel.evaluate_into::<N, B>(
-            mesh,
-            &located,
-            &x,
-            gradient,
-            &mut nodes,
-            &mut values,
-            &mut gradients,
-        );
+        let got = common::evaluate_into_vecs::<D, N, B>(&kernel, mesh, s, &x, gradient);
         match (expected, got) {
-            (Ok(()), Ok(condition)) => {
+            (Ok(()), Ok(((nodes, values, gradients), condition))) => {
                 prop_assert_eq!(condition.to_bits(), stencil.condition_number().to_bits());
-                prop_assert_eq!(&nodes[..], stencil.nodes());
-                for (a, b) in values.iter().zip(stencil.values()) {
-                    prop_assert_eq!(a.to_bits(), b.to_bits());
-                }
-                for (a, b) in gradients.iter().zip(stencil.gradients()) {
-                    for (p, q) in a.iter().zip(b.iter()) {
-                        prop_assert_eq!(p.to_bits(), q.to_bits());
-                    }
-                }
+                common::same_entries(
+                    (&nodes, &values, &gradients),
+                    (stencil.nodes(), stencil.values(), stencil.gradients()),
+                )?;
             }
             (Err(a), Err(b)) => prop_assert_eq!(a.to_string(), b.to_string()),
             (a, b) => prop_assert!(false, "evaluate {:?}, evaluate_into {:?}", a, b),

@@ -114,3 +114,53 @@ pub fn fine_cuboid() -> impl Strategy<Value = SimplexMesh<3>> {
         },
     )
 }
+
+/// Node indices, shape-function values and gradients of one stencil.
+pub type Entries<const D: usize> = (Vec<u32>, Vec<f64>, Vec<SVector<f64, D>>);
+
+/// `kernel.evaluate_into` at `x` in simplex `s` into vectors of the 1-ring's length: the
+/// entries and the condition number.
+pub fn evaluate_into_vecs<const D: usize, const N: usize, B: umls_mls::PolynomialBasis<D, N>>(
+    kernel: &umls_mls::UmlsKernel<D>,
+    mesh: &SimplexMesh<D>,
+    s: usize,
+    x: &SVector<f64, D>,
+    gradient: umls_mls::GradientKind,
+) -> Result<(Entries<D>, f64), umls_mls::MlsError> {
+    let ring = mesh.topology().one_ring(s).len();
+    let (mut nodes, mut values) = (vec![0u32; ring], vec![0.0; ring]);
+    let mut gradients = vec![SVector::<f64, D>::zeros(); ring];
+    let located = umls_mesh::Located {
+        simplex: s as u32,
+        barycentric: mesh.barycentric(s, x),
+    };
+    let condition = kernel.evaluate_into::<N, B>(
+        mesh,
+        &located,
+        x,
+        gradient,
+        &mut nodes,
+        &mut values,
+        &mut gradients,
+    )?;
+    Ok(((nodes, values, gradients), condition))
+}
+
+/// The same nodes, and values and gradients equal to the last bit.
+pub fn same_entries<const D: usize>(
+    got: (&[u32], &[f64], &[SVector<f64, D>]),
+    expected: (&[u32], &[f64], &[SVector<f64, D>]),
+) -> Result<(), TestCaseError> {
+    prop_assert_eq!(got.0, expected.0);
+    prop_assert_eq!(got.1.len(), expected.1.len());
+    for (a, b) in got.1.iter().zip(expected.1) {
+        prop_assert_eq!(a.to_bits(), b.to_bits(), "N {} against {}", a, b);
+    }
+    prop_assert_eq!(got.2.len(), expected.2.len());
+    for (a, b) in got.2.iter().zip(expected.2) {
+        for (p, q) in a.iter().zip(b.iter()) {
+            prop_assert_eq!(p.to_bits(), q.to_bits(), "∇N {} against {}", a, b);
+        }
+    }
+    Ok(())
+}
