@@ -4,7 +4,9 @@
 //! iteration, in particle-steps per second, with 1 and 2 threads, for quadratic B-splines
 //! on the 64³ grid and UMLS on the 64³-cell Kuhn lattice of tetrahedra (1.57 M tets, the
 //! same node spacing), and quadratic B-splines with MLS-MPM (Taichi's own transfer: the
-//! force folded into the affine momentum). The comparison with Taichi runs the same scene through
+//! force folded into the affine momentum); UMLS once more with its stencils kept as the
+//! fits' factors (`StencilStorage::Factored`: half the memory, rebuilt in P2G and G2P).
+//! The comparison with Taichi runs the same scene through
 //! `umls run fluid-box-3d`; this bench isolates the step from scene set-up and output.
 
 use std::sync::Arc;
@@ -15,8 +17,8 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::{SVector, Vector3};
 use umls::constitutive::WeaklyCompressibleFluid;
 use umls::engine::{
-    Apic, MlsMpm, Particles, Simulation, StepSettings, TransferScheme, Wall, WallKind,
-    lattice_points,
+    Apic, MlsMpm, Particles, Simulation, StencilStorage, StepSettings, TransferScheme, Wall,
+    WallKind, lattice_points,
 };
 use umls::kernels::{BSplineKernel, BSplineOrder, Umls3};
 use umls::mesh::generate::Lattice;
@@ -38,9 +40,11 @@ fn particles<C: Copy + Default>() -> Particles<3, (), C> {
 fn scene<K: Kernel<3>, T: TransferScheme>(
     kernel: K,
     transfer: T,
+    storage: StencilStorage,
 ) -> Simulation<3, K, WeaklyCompressibleFluid, T> {
     let material = WeaklyCompressibleFluid::new(400.0, 1.0).expect("valid");
     let mut settings = StepSettings::new(2e-4);
+    settings.stencil_storage = storage;
     settings.gravity = Vector3::new(0.0, -9.8, 0.0);
     let mut sim =
         Simulation::new(kernel, material, transfer, particles(), settings).expect("valid");
@@ -68,11 +72,12 @@ fn bench<K: Kernel<3> + Clone, T: TransferScheme>(
     name: &str,
     kernel: K,
     transfer: T,
+    storage: StencilStorage,
 ) {
     let mut g = c.benchmark_group("fluid_box_3d_64k");
     g.throughput(Throughput::Elements(64_000));
     g.sample_size(10);
-    common::step_with_threads(&mut g, name, || scene(kernel.clone(), transfer));
+    common::step_with_threads(&mut g, name, || scene(kernel.clone(), transfer, storage));
     g.finish();
 }
 
@@ -86,12 +91,15 @@ fn fluid_box(c: &mut Criterion) {
         BSplineOrder::Quadratic,
     )
     .expect("grid");
-    bench(c, "bspline2", grid.clone(), Apic);
-    bench(c, "bspline2_mls_mpm", grid, MlsMpm);
+    let auto = StencilStorage::KernelChoice;
+    bench(c, "bspline2", grid.clone(), Apic, auto);
+    bench(c, "bspline2_mls_mpm", grid, MlsMpm, auto);
     let mesh = Lattice::new([0.0; 3], [1.0; 3], [CELLS; 3])
         .tetrahedra()
         .expect("mesh");
-    bench(c, "umls_tet", Umls3::new(Arc::new(mesh)), Apic);
+    let umls = Umls3::new(Arc::new(mesh));
+    bench(c, "umls_tet", umls.clone(), Apic, auto);
+    bench(c, "umls_tet_factored", umls, Apic, StencilStorage::Factored);
 }
 
 criterion_group!(benches, fluid_box);
