@@ -236,7 +236,7 @@ pub enum StencilsSpec {
     Store,
     /// Store the kernel's factors of each stencil (UMLS: the fit's weights and inverse
     /// moment matrix) and rebuild the entries where used: about half the stencil memory
-    /// for 10–14 % more time; entries for kernels without factors.
+    /// for 10–17 % more time; entries for kernels without factors.
     Factored,
     /// Recompute stencils in P2G and G2P (less memory, more work).
     Recompute,

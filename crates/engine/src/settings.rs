@@ -56,7 +56,7 @@ pub enum StencilStorage {
     /// (`Kernel::factor_layout`; UMLS with the reconstructed gradient: 8 bytes per entry
     /// and (D + 1)² + 1 numbers per particle), rebuilding the entries in P2G and G2P;
     /// the entries where it has none. About half the stored bytes of UMLS in 3D for
-    /// 10–14 % more time per step (docs/scenes.md).
+    /// 10–17 % more time per step (docs/scenes.md).
     Factored,
     /// Evaluate them in P2G and G2P (three evaluations a step with the ordering pass).
     Recompute,
