@@ -34,15 +34,20 @@ struct ChunkStencils<const D: usize> {
 }
 
 impl<const D: usize> ChunkStencils<D> {
-    /// Empties the arrays for a step of `mode`, giving back those it does not use (what
-    /// an earlier step of another mode held).
+    /// Empties the arrays for a step of `mode` (the per-particle factors are sized by
+    /// `compute` instead), giving back those it does not use (what an earlier step of
+    /// another mode held).
     fn clear_for(&mut self, mode: Mode) {
         let entries = mode == Mode::Entries;
         let factors = matches!(mode, Mode::Factored(_));
         clear_or_release(&mut self.nodes, entries);
         clear_or_release(&mut self.values, entries);
         clear_or_release(&mut self.gradients, entries);
-        clear_or_release(&mut self.particle_factors, factors);
+        // The per-particle factors keep their length: `compute` resizes them to the chunk,
+        // and every slot is written before it is read, so they need no zero-fill a step.
+        if !factors {
+            self.particle_factors = Vec::new();
+        }
         clear_or_release(&mut self.entry_factors, factors);
         clear_or_release(&mut self.offsets, mode != Mode::Recompute);
     }
