@@ -478,6 +478,7 @@ fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     settings.gravity_ramp = ctx.setup.gravity_ramp;
     settings.stress_update = ctx.setup.stress_update;
     settings.stencil_storage = ctx.scene.spec.kernel.stencils.storage();
+    settings.mass_matrix = crate::schema::MassSpec::matrix(ctx.scene.spec.transfer.mass);
     settings.damping = ctx.setup.damping;
     let mut sim = Simulation::new(kernel, table, transfer, particles, settings)?;
     if let Some(field) = &ctx.setup.body_force {
@@ -629,6 +630,18 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
 }
 
 fn transfer_name(spec: &crate::schema::TransferSpec) -> String {
+    let name = transfer_kind_name(spec);
+    match spec.mass {
+        None => name,
+        Some(m) => format!(
+            "{name}, consistent mass ({} iterations{})",
+            m.iterations,
+            if m.forces { ", forces too" } else { "" }
+        ),
+    }
+}
+
+fn transfer_kind_name(spec: &crate::schema::TransferSpec) -> String {
     match spec.kind {
         TransferKind::Pic => "pic".into(),
         TransferKind::Flip => format!("flip (alpha {})", spec.alpha),

@@ -356,6 +356,32 @@ pub struct TransferSpec {
     /// FLIP fraction of `flip` and `apic-flip`, in [0, 1] (default 0.99).
     #[serde(default = "default_alpha")]
     pub alpha: f64,
+    /// The consistent mass matrix, `{ iterations = k, forces = … }` (default: lumped;
+    /// not with `mls-mpm`).
+    pub mass: Option<MassSpec>,
+}
+
+/// `transfer.mass`: the consistent mass matrix, approximated by Jacobi iterations.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MassSpec {
+    /// Jacobi iterations (1 or more).
+    pub iterations: usize,
+    /// Whether the forces are solved with it too (default false: the velocity only).
+    #[serde(default)]
+    pub forces: bool,
+}
+
+impl MassSpec {
+    /// The engine's setting.
+    pub fn matrix(spec: Option<Self>) -> umls_engine::MassMatrix {
+        spec.map_or(umls_engine::MassMatrix::Lumped, |m| {
+            umls_engine::MassMatrix::Consistent {
+                iterations: m.iterations,
+                forces: m.forces,
+            }
+        })
+    }
 }
 
 fn default_alpha() -> f64 {
@@ -367,6 +393,7 @@ impl Default for TransferSpec {
         Self {
             kind: TransferKind::default(),
             alpha: default_alpha(),
+            mass: None,
         }
     }
 }

@@ -306,7 +306,12 @@ impl<const D: usize> Grid<D> {
 
 /// Whether a node with mass `m` and Σ|N| m_p = `abs_mass` carries velocity: above the
 /// round-off mass, and not mostly cancelled by negative MLS values.
-fn active_node(m: f64, abs_mass: f64, round_off: f64, cancellation_fraction: f64) -> bool {
+pub(crate) fn active_node(
+    m: f64,
+    abs_mass: f64,
+    round_off: f64,
+    cancellation_fraction: f64,
+) -> bool {
     abs_mass > round_off && m.abs() > cancellation_fraction * abs_mass
 }
 

@@ -68,7 +68,7 @@ pub use fitted_clamp::{FITTED_CLAMP_REGULARISATION, FittedClamp};
 pub use memory::MemoryUse;
 pub use particles::Particles;
 pub use seeding::{Inside, Region, lattice_points, lattice_samples};
-pub use settings::{Damping, StencilStorage, StepSettings, TimeStepControl};
+pub use settings::{Damping, MassMatrix, StencilStorage, StepSettings, TimeStepControl};
 pub use simulation::{BodyForce, Simulation};
 pub use timing::StageTimes;
 pub use transfer::{

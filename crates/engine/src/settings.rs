@@ -62,6 +62,61 @@ pub enum StencilStorage {
     Recompute,
 }
 
+/// The mass matrix of the grid update. The lumped one (row sums m_i = Σ_p N_ip m_p) makes
+/// the velocity v_i = p_i / m_i a weighted mean of the particle velocities, so every
+/// P2G → G2P round trip smooths the particle field, the more the wider the stencil. The
+/// consistent one, M_ij = Σ_p m_p N_ip N_jp, makes it the mass-weighted least-squares
+/// projection onto the nodal basis; its inverse is approximated by Jacobi iterations
+/// preconditioned by the lumped matrix (Nairn and Hammerquist's FMPM), each costing one
+/// gather and one scatter over the stencils. docs/umls-kernel.md ("Mass matrix") has the
+/// measurements.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MassMatrix {
+    /// Lumped: v_i = p_i / m_i, a_i = f_i / m_i (the default).
+    #[default]
+    Lumped,
+    /// The consistent matrix, approximated by `iterations` ≥ 1 Jacobi iterations, for the
+    /// velocity and, with `forces`, for the acceleration too.
+    ///
+    /// - For the velocity it keeps what the particles carry through the round trip
+    ///   (PIC, APIC and the PIC part of FLIP lose less energy). With an affine transfer
+    ///   the round trip carries each particle's affine field, so affine velocity fields
+    ///   stay fixed points.
+    /// - For the forces it is the consistent-mass equation of motion, whose frequencies
+    ///   are those of the kernel's basis rather than of its lumping (the vibrating bar's
+    ///   error halves). k iterations raise the highest frequency by up to √k, so the
+    ///   stable Δt is divided by √k ([`crate::Simulation::stable_time_step`]).
+    ///
+    /// Not with MLS-MPM, whose momenta carry the force impulse.
+    Consistent {
+        /// Jacobi iterations (1 or more).
+        iterations: usize,
+        /// Whether the forces are solved too.
+        forces: bool,
+    },
+}
+
+impl MassMatrix {
+    /// Jacobi iterations for the velocity (0 when lumped).
+    pub fn velocity_iterations(&self) -> usize {
+        match *self {
+            Self::Lumped => 0,
+            Self::Consistent { iterations, .. } => iterations,
+        }
+    }
+
+    /// Jacobi iterations for the forces (0 when they stay lumped).
+    pub fn force_iterations(&self) -> usize {
+        match *self {
+            Self::Consistent {
+                iterations,
+                forces: true,
+            } => iterations,
+            _ => 0,
+        }
+    }
+}
+
 /// Step settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepSettings<const D: usize> {
@@ -102,12 +157,15 @@ pub struct StepSettings<const D: usize> {
     pub measure_reactions: bool,
     /// Stored or recomputed stencils.
     pub stencil_storage: StencilStorage,
+    /// The mass matrix that turns P2G's nodal momenta (and forces) into velocities (and
+    /// accelerations).
+    pub mass_matrix: MassMatrix,
 }
 
 impl<const D: usize> StepSettings<D> {
     /// Time step `dt` (fixed), no gravity, USL, no damping, energy limit 10× checked every
     /// 10 steps, Courant and wave Courant limits 1, cancellation fraction 10⁻³, stencils
-    /// stored or recomputed as the kernel prefers.
+    /// stored or recomputed as the kernel prefers, lumped mass matrix.
     pub fn new(dt: f64) -> Self {
         Self {
             dt,
@@ -123,6 +181,7 @@ impl<const D: usize> StepSettings<D> {
             cancellation_fraction: 1e-3,
             measure_reactions: true,
             stencil_storage: StencilStorage::KernelChoice,
+            mass_matrix: MassMatrix::Lumped,
         }
     }
 

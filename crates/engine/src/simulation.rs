@@ -21,6 +21,7 @@ mod checks;
 mod constitutive;
 mod fitted_clamps;
 mod grid_to_particles;
+mod mass_matrix;
 mod musl;
 mod particles_to_grid;
 
@@ -56,6 +57,12 @@ fn check_transfer<const D: usize, K: Kernel<D>, T: TransferScheme>(
         return unsupported(
             "damping",
             "the force is folded into the momentum, and damping acts on the nodal force",
+        );
+    }
+    if settings.mass_matrix != crate::settings::MassMatrix::Lumped {
+        return unsupported(
+            "the consistent mass matrix",
+            "its momenta carry the force impulse, which the lumped mass must divide",
         );
     }
     if settings.stress_update == StressUpdate::Musl {
@@ -106,6 +113,8 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     velocity_gradients: Vec<SMatrix<f64, D, D>>,
     /// This step's least-squares systems of the boundary's fitted clamps.
     clamp_systems: Vec<crate::fitted_clamp::ClampSystem<D>>,
+    /// Buffers of the mass-matrix iterations (empty without them).
+    mass_solve: mass_matrix::MassSolve<D>,
 }
 
 /// Checks a number setting.
@@ -173,6 +182,14 @@ impl<const D: usize> StepSettings<D> {
                 reason: "must be finite",
             });
         }
+        if let crate::settings::MassMatrix::Consistent { iterations, .. } = self.mass_matrix {
+            check(
+                "mass_matrix.iterations",
+                iterations as f64,
+                iterations >= 1,
+                "must be at least 1",
+            )?;
+        }
         if let TimeStepControl::Adaptive { cfl } = self.time_step {
             check("cfl", cfl, cfl > 0.0, "must be finite and positive")?;
         }
@@ -227,6 +244,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             reactions: Default::default(),
             velocity_gradients: Vec::new(),
             clamp_systems: Vec::new(),
+            mass_solve: Default::default(),
             grid,
         })
     }
@@ -297,7 +315,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             nodes: self.grid.bytes()
                 + windows
                 + self.reactions.0.bytes()
-                + bytes(&self.reactions.1),
+                + bytes(&self.reactions.1)
+                + self.mass_solve.bytes(),
         }
     }
 
@@ -331,16 +350,20 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .reduce(|| (0.0, f64::INFINITY), |a, b| (a.0.max(b.0), a.1.min(b.1)))
     }
 
-    /// The explicit step bound cfl · h / (c + |v|_max) from a speed and a density.
+    /// The explicit step bound cfl · h / (c + |v|_max) from a speed and a density,
+    /// divided by √k when k mass iterations act on the forces (they raise the highest
+    /// frequency by up to √k).
     fn stable_step_from(&self, cfl: f64, max_speed: f64, min_density: f64) -> f64 {
         let c = self.material.p_wave_speed(min_density);
-        cfl * self.kernel.spacing() / (c + max_speed)
+        let iterations = self.settings.mass_matrix.force_iterations().max(1);
+        cfl * self.kernel.spacing() / (c + max_speed) / (iterations as f64).sqrt()
     }
 
     /// The stable time step for Courant number `cfl`: cfl · h / (c + |v|_max), with h the
     /// kernel's effective spacing ([`Kernel::spacing`]), c the p-wave speed at the
     /// smallest current particle density and |v|_max the fastest particle. The same
-    /// definition for every kernel; `cfl` = 1 is the stability limit.
+    /// definition for every kernel; `cfl` = 1 is the stability limit. With k mass
+    /// iterations on the forces ([`crate::MassMatrix::Consistent`]) it is divided by √k.
     pub fn stable_time_step(&self, cfl: f64) -> f64 {
         let (speed, density) = self.speed_and_density();
         self.stable_step_from(cfl, speed, density)
@@ -426,7 +449,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             mass: p.mass.iter().sum(),
             max_speed,
             courant: max_speed * dt / h,
-            wave_courant: (c + max_speed) * dt / h,
+            wave_courant: (c + max_speed) * dt / h
+                * (self.settings.mass_matrix.force_iterations().max(1) as f64).sqrt(),
             dropped_mass: self.totals.dropped_mass,
             redistributed_momentum: self.totals.redistributed_momentum,
             wall_corrections: self.totals.wall_corrections,
@@ -530,6 +554,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         self.compute_stresses()?;
         self.times.constitutive += clock.lap();
         self.particles_to_grid()?;
+        self.iterate_mass_matrix()?;
         self.times.particles_to_grid += clock.lap();
         // 3. Grid update, summing the reaction sets' forces only when they will be read.
         let measure = self.settings.measure_reactions && !self.boundary.reaction_sets.is_empty();

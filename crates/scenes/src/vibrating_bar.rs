@@ -153,6 +153,17 @@ impl VibratingBar {
         kernel: K,
         transfer: T,
     ) -> Result<BarError, EngineError> {
+        self.run_with(kernel, transfer, |_| {})
+    }
+
+    /// [`Self::run`] with the step settings (Δt set by the scene) changed by `adjust`
+    /// first, e.g. to compare mass matrices or stencil storage on the same bar.
+    pub fn run_with<K: Kernel<1>, T: TransferScheme>(
+        &self,
+        kernel: K,
+        transfer: T,
+        adjust: impl FnOnce(&mut StepSettings<1>),
+    ) -> Result<BarError, EngineError> {
         let material = self.material().map_err(|source| EngineError::Material {
             step: 0,
             particle: 0,
@@ -161,8 +172,9 @@ impl VibratingBar {
         let (steps, dt) = self.steps_and_dt();
         let particles = self.particles();
         let reference: Vec<f64> = particles.position.iter().map(|x| x[0]).collect();
-        let mut sim =
-            Simulation::new(kernel, material, transfer, particles, StepSettings::new(dt))?;
+        let mut settings = StepSettings::new(dt);
+        adjust(&mut settings);
+        let mut sim = Simulation::new(kernel, material, transfer, particles, settings)?;
         if self.fixed_end == FixedEnd::Node {
             sim.boundary.fixed = vec![0];
         }
