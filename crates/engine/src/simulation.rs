@@ -110,6 +110,8 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
         crate::grid::ReactionScratch<D>,
         Vec<crate::boundary::Reaction<D>>,
     ),
+    /// MUSL's re-mapped velocity gradients (empty under USL, whose G2P leaves the
+    /// gradients in `stress_buffer`).
     velocity_gradients: Vec<SMatrix<f64, D, D>>,
     /// This step's least-squares systems of the boundary's fitted clamps.
     clamp_systems: Vec<crate::fitted_clamp::ClampSystem<D>>,
@@ -611,13 +613,14 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         self.grid_to_particles(dt)?;
         if self.settings.stress_update == StressUpdate::Musl {
             self.musl_velocity_gradients()?;
+            // The update reads the gradients from the stress buffer, as G2P leaves
+            // them under USL.
+            self.stresses_current = false;
+            self.stress_buffer.clone_from(&self.velocity_gradients);
         }
         self.times.grid_to_particles += clock.lap();
         // 5. Deformation and stress update.
-        let gradients = std::mem::take(&mut self.velocity_gradients);
-        let deformed = self.update_deformation(&gradients, dt);
-        self.velocity_gradients = gradients;
-        let min_density = deformed?;
+        let min_density = self.update_deformation(dt)?;
         self.times.constitutive += clock.lap();
         self.step += 1;
         self.time += dt;

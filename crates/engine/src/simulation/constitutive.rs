@@ -48,17 +48,15 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
 
     /// F ← (I + Δt ∇v) F, the return map, and the stress of the returned state for the
     /// next step's P2G, in one call of the material (`return_map_and_stress`: one
-    /// decomposition for plastic models); the smallest density m / (V⁰ det F).
-    pub(super) fn update_deformation(
-        &mut self,
-        velocity_gradients: &[SMatrix<f64, D, D>],
-        dt: f64,
-    ) -> Result<f64, EngineError> {
+    /// decomposition for plastic models); the smallest density m / (V⁰ det F). Each
+    /// particle's velocity gradient is read from its slot of the stress buffer (where
+    /// G2P left it) and replaced there by its stress.
+    pub(super) fn update_deformation(&mut self, dt: f64) -> Result<f64, EngineError> {
         let step = self.step;
         let material = &self.material;
         let p = &mut self.particles;
         let (mass, volume) = (&p.mass, &p.volume);
-        self.stress_buffer.resize(p.len(), SMatrix::zeros());
+        debug_assert_eq!(self.stress_buffer.len(), p.len());
         // In fixed chunks, each folding its particles in a plain loop (a per-particle
         // `Result` carried through the parallel reduction cost as much as a fluid's
         // whole stress update); the chunks' minima and first failures are joined in
@@ -68,23 +66,22 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .deformation
             .par_chunks_mut(chunk)
             .zip(p.state.par_chunks_mut(chunk))
-            .zip(velocity_gradients.par_chunks(chunk))
             .zip(self.stress_buffer.par_chunks_mut(chunk))
             .enumerate()
-            .map(|(c, (((fs, states), gvs), stresses))| {
+            .map(|(c, ((fs, states), stresses))| {
                 let mut min_density = f64::INFINITY;
                 // A failing particle does not stop its chunk: every particle is updated
                 // as far as it gets, whichever fails, and the first failure is reported.
                 let mut first_failure = None;
-                for (k, (((f, state), gv), stress)) in fs
+                for (k, ((f, state), stress)) in fs
                     .iter_mut()
                     .zip(states.iter_mut())
-                    .zip(gvs)
                     .zip(stresses.iter_mut())
                     .enumerate()
                 {
                     let i = c * chunk + k;
-                    match update_one(material, f, state, gv, stress, dt, step, i) {
+                    let gv = *stress;
+                    match update_one(material, f, state, &gv, stress, dt, step, i) {
                         Ok(det) => min_density = min_density.min(mass[i] / (volume[i] * det)),
                         Err(e) => {
                             first_failure.get_or_insert((i, e));

@@ -11,7 +11,7 @@ use crate::boundary::Boundary;
 use crate::error::EngineError;
 use crate::parallel::lowest_failure;
 use crate::stencils::{EntrySink, Stencils};
-use crate::transfer::TransferScheme;
+use crate::transfer::{StressUpdate, TransferScheme};
 
 /// What G2P computes for one particle.
 #[derive(Debug, Clone, Copy)]
@@ -138,15 +138,27 @@ struct ChunkTotals {
 }
 
 impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
-    /// G2P and the walls; the velocity gradients go to `self.velocity_gradients`.
+    /// G2P and the walls. The velocity gradients go to the stress buffer under USL (P2G
+    /// has read this step's stresses, and the deformation update turns each gradient
+    /// into the next stress in place, so no buffer of its own is needed), and to
+    /// `self.velocity_gradients` under MUSL, whose re-map replaces them.
     pub(super) fn grid_to_particles(&mut self, dt: f64) -> Result<(), EngineError> {
+        let in_stress_buffer = self.settings.stress_update == StressUpdate::Usl;
+        if in_stress_buffer {
+            self.stresses_current = false;
+        }
+        let destination = if in_stress_buffer {
+            &mut self.stress_buffer
+        } else {
+            &mut self.velocity_gradients
+        };
+        let mut velocity_gradients = std::mem::take(destination);
+        velocity_gradients.resize(self.particles.len(), SMatrix::zeros());
         let (kernel, transfer, stencils) = (&self.kernel, self.transfer, &self.stencils);
         let grid = GridVelocities {
             old: &self.grid.velocity,
             new: &self.grid.new_velocity,
         };
-        let mut velocity_gradients = std::mem::take(&mut self.velocity_gradients);
-        velocity_gradients.resize(self.particles.len(), SMatrix::zeros());
         let p = &mut self.particles;
         let (gravity, time, step) = (self.settings.gravity_at(self.time), self.time, self.step);
         let body_force = self.body_force.as_ref();
@@ -254,7 +266,11 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     })
                 },
             );
-        self.velocity_gradients = velocity_gradients;
+        if in_stress_buffer {
+            self.stress_buffer = velocity_gradients;
+        } else {
+            self.velocity_gradients = velocity_gradients;
+        }
         let partials = partials.map_err(|(particle, source)| EngineError::Kernel {
             step,
             particle,
