@@ -115,18 +115,21 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let grid = &self.grid;
         let active = |i: usize| grid.is_active(i, fraction);
         let rhs_in: &[SVector<f64, D>] = rhs;
-        solve
-            .velocity
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(NODE_CHUNK)
-            .for_each(|(i, v)| {
-                *v = if active(i) {
-                    rhs_in[i] / grid.mass[i]
-                } else {
-                    SVector::zeros()
-                };
-            });
+        // One Jacobi update v ← v + (rhs − A v) / m on the active nodes; the first,
+        // from v = 0 (no product), is the lumped v = rhs / m.
+        let jacobi = |velocity: &mut [SVector<f64, D>], product: Option<&[SVector<f64, D>]>| {
+            velocity
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(NODE_CHUNK)
+                .for_each(|(i, v)| match (active(i), product) {
+                    (true, Some(product)) => *v += (rhs_in[i] - product[i]) / grid.mass[i],
+                    (true, None) => *v = rhs_in[i] / grid.mass[i],
+                    (false, Some(_)) => {}
+                    (false, None) => *v = SVector::zeros(),
+                });
+        };
+        jacobi(&mut solve.velocity, None);
         let boundary = &self.boundary;
         boundary.apply(&mut solve.velocity);
         let (p, kernel, stencils, transfer) =
@@ -194,17 +197,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     particle,
                     source,
                 })?;
-            let product = &solve.product;
-            solve
-                .velocity
-                .par_iter_mut()
-                .enumerate()
-                .with_min_len(NODE_CHUNK)
-                .for_each(|(i, v)| {
-                    if active(i) {
-                        *v += (rhs_in[i] - product[i]) / grid.mass[i];
-                    }
-                });
+            jacobi(&mut solve.velocity, Some(&solve.product));
             // Projected Jacobi: the iterates stay admissible, so the constrained
             // components take no part in the fit of the free ones.
             boundary.apply(&mut solve.velocity);
