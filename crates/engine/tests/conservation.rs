@@ -10,7 +10,7 @@ use umls_engine::{
     Apic, ApicFlip, Flip, MlsMpm, Particles, Pic, Simulation, StepSettings, StressUpdate,
     TransferScheme, VelocityGradientAffine,
 };
-use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, Umls2};
+use umls_kernels::{BSplineOrder, LinearFeKernel, Umls2};
 use umls_mesh::generate::{Diagonal, Lattice};
 use umls_transfer::Kernel;
 
@@ -61,18 +61,9 @@ fn check<K: Kernel<2>, T: TransferScheme>(kernel: K, transfer: T, update: Stress
     );
 }
 
-fn mesh() -> Arc<umls_mesh::SimplexMesh<2>> {
-    Arc::new(
-        Lattice::new([0.0, 0.0], [1.0, 1.0], [20, 20])
-            .jitter(0.2, 3)
-            .triangles(Diagonal::Alternating)
-            .unwrap(),
-    )
-}
-
-fn grid(order: BSplineOrder) -> BSplineKernel<2> {
-    BSplineKernel::new(SVector::from([0.0, 0.0]), 0.05, [20, 20], order).unwrap()
-}
+#[path = "common/unit_square.rs"]
+mod unit_square;
+use unit_square::{grid, mesh};
 
 macro_rules! every_transfer {
     ($kernel:expr) => {

@@ -3,16 +3,13 @@
 //! round trip the more it iterates, momentum stays conserved, results stay independent
 //! of the thread count, and what it cannot do is refused by name.
 
-use std::sync::Arc;
-
-use nalgebra::{Matrix2, SVector, Vector2};
+use nalgebra::{Matrix2, Vector2};
 use umls_constitutive::{ElasticParameters, NeoHookean};
 use umls_engine::{
     Apic, EngineError, Flip, MassMatrix, MlsMpm, Particles, Pic, Simulation, StepSettings,
     TransferScheme,
 };
 use umls_kernels::{BSplineKernel, BSplineOrder, Umls2};
-use umls_mesh::generate::{Diagonal, Lattice};
 use umls_transfer::Kernel;
 
 fn material(young: f64) -> NeoHookean {
@@ -41,23 +38,13 @@ fn block<C: Copy + Default>(v: impl Fn(&Vector2<f64>) -> Vector2<f64>) -> Partic
     p
 }
 
-fn mesh() -> Arc<umls_mesh::SimplexMesh<2>> {
-    Arc::new(
-        Lattice::new([0.0, 0.0], [1.0, 1.0], [20, 20])
-            .jitter(0.2, 3)
-            .triangles(Diagonal::Alternating)
-            .unwrap(),
-    )
-}
+#[path = "common/unit_square.rs"]
+mod unit_square;
+use unit_square::mesh;
 
+/// Quadratic B-splines over the unit square.
 fn grid() -> BSplineKernel<2> {
-    BSplineKernel::new(
-        SVector::from([0.0, 0.0]),
-        0.05,
-        [20, 20],
-        BSplineOrder::Quadratic,
-    )
-    .unwrap()
+    unit_square::grid(BSplineOrder::Quadratic)
 }
 
 fn consistent(iterations: usize, forces: bool) -> MassMatrix {
