@@ -26,7 +26,7 @@ enum Command {
         /// Shape-function kernel (default: the scene's).
         #[arg(long, value_enum)]
         kernel: Option<KernelKind>,
-        /// Output directory (default: out/<scene name>-<kernel>); the files of an earlier run
+        /// Output directory (default: out/SCENE-KERNEL); the files of an earlier run
         /// there are replaced.
         #[arg(long)]
         out: Option<PathBuf>,

@@ -4,7 +4,7 @@
 //! Each (dimension, kernel, transfer, plasticity) combination is its own monomorphized
 //! simulation, so a run steps with exactly the code its scene needs. The run loop around
 //! it (time step, boundaries, output, history, summary) sees the simulation through the
-//! object-safe [`Run`] trait and is compiled once per dimension.
+//! object-safe `Run` trait and is compiled once per dimension.
 
 use std::path::PathBuf;
 use std::sync::Arc;

@@ -58,7 +58,7 @@ const PALETTE: [RGBColor; 8] = [
 /// One axis: its label (with the unit in brackets) and its scale.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Axis {
-    /// Label, e.g. "time t [s]".
+    /// Label, e.g. `time t [s]`.
     pub label: String,
     /// Logarithmic scale.
     pub log: bool,

@@ -7,7 +7,7 @@
 //!
 //! Written here rather than taken from `mshio` because that crate reads 4.1 only, and
 //! because every error must name the line (or byte) and section at fault; the parser is
-//! a few hundred lines over one [`cursor`] and is fuzzed by the crate's tests.
+//! a few hundred lines over one `cursor` and is fuzzed by the crate's tests.
 
 mod convert;
 mod cursor;
