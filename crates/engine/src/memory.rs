@@ -10,8 +10,8 @@ pub struct MemoryUse {
     /// The particle state: positions, velocities, affine matrices and moments,
     /// deformation gradients, volumes, masses, material states, location caches.
     pub particles: usize,
-    /// Per-particle scratch of a step: stresses (which carry the velocity gradients
-    /// under USL), MUSL's velocity gradients, stencil node ranges, the P2G ordering.
+    /// Per-particle scratch of a step: stresses (which also carry the velocity
+    /// gradients to the deformation update), stencil node ranges, the P2G ordering.
     pub particle_scratch: usize,
     /// Stored stencils (zero where they are recomputed).
     pub stencils: usize,

@@ -110,9 +110,6 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
         crate::grid::ReactionScratch<D>,
         Vec<crate::boundary::Reaction<D>>,
     ),
-    /// MUSL's re-mapped velocity gradients (empty under USL, whose G2P leaves the
-    /// gradients in `stress_buffer`).
-    velocity_gradients: Vec<SMatrix<f64, D, D>>,
     /// This step's least-squares systems of the boundary's fitted clamps.
     clamp_systems: Vec<crate::fitted_clamp::ClampSystem<D>>,
     /// Buffers of the mass-matrix iterations (empty without them).
@@ -244,7 +241,6 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             stress_buffer: Vec::new(),
             stresses_current: false,
             reactions: Default::default(),
-            velocity_gradients: Vec::new(),
             clamp_systems: Vec::new(),
             mass_solve: Default::default(),
             grid,
@@ -309,10 +305,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 + bytes(&p.mass)
                 + bytes(&p.state)
                 + bytes(&p.cache),
-            particle_scratch: bytes(&self.stress_buffer)
-                + bytes(&self.velocity_gradients)
-                + ranges
-                + order,
+            particle_scratch: bytes(&self.stress_buffer) + ranges + order,
             stencils: stored,
             nodes: self.grid.bytes()
                 + windows
@@ -613,10 +606,6 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         self.grid_to_particles(dt)?;
         if self.settings.stress_update == StressUpdate::Musl {
             self.musl_velocity_gradients()?;
-            // The update reads the gradients from the stress buffer, as G2P leaves
-            // them under USL.
-            self.stresses_current = false;
-            self.stress_buffer.clone_from(&self.velocity_gradients);
         }
         self.times.grid_to_particles += clock.lap();
         // 5. Deformation and stress update.

@@ -1,7 +1,7 @@
 //! What a simulation holds per particle, from its own accounting
 //! (`Simulation::memory_use`): the particle state plus a step's per-particle scratch stays
-//! within 400 bytes for quadratic B-splines in 3D (stencils recomputed where used; a USL
-//! step keeps no velocity-gradient buffer besides the stresses) and
+//! within 400 bytes for quadratic B-splines in 3D (stencils recomputed where used; a step
+//! keeps no velocity-gradient buffer besides the stresses) and
 //! 600 bytes for UMLS with recomputed stencils; stored stencils add their entries, or
 //! about a quarter of that as UMLS factors.
 
@@ -46,7 +46,7 @@ fn bspline_particles_stay_within_400_bytes_and_stored_stencils_are_the_differenc
     assert!(per_particle <= 400.0, "{per_particle} B per particle");
     // The state alone: x, v (24 B each), C, F (72 B each), C's moment, V⁰, m (8 B each).
     assert!(recomputed.particles >= recomputed.particle_count * 216);
-    // A USL step's scratch: the stresses (72 B; G2P leaves the velocity gradients in
+    // A step's scratch: the stresses (72 B; G2P leaves the velocity gradients in
     // their slots), the node range (8 B) and the P2G order (12 B, its key vector growing
     // by doubling), not a velocity-gradient buffer besides.
     let scratch = recomputed.particle_scratch as f64 / recomputed.particle_count as f64;

@@ -11,7 +11,7 @@ use crate::boundary::Boundary;
 use crate::error::EngineError;
 use crate::parallel::lowest_failure;
 use crate::stencils::{EntrySink, Stencils};
-use crate::transfer::{StressUpdate, TransferScheme};
+use crate::transfer::TransferScheme;
 
 /// What G2P computes for one particle.
 #[derive(Debug, Clone, Copy)]
@@ -138,21 +138,13 @@ struct ChunkTotals {
 }
 
 impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
-    /// G2P and the walls. The velocity gradients go to the stress buffer under USL (P2G
-    /// has read this step's stresses, and the deformation update turns each gradient
-    /// into the next stress in place, so no buffer of its own is needed), and to
-    /// `self.velocity_gradients` under MUSL, whose re-map replaces them.
+    /// G2P and the walls. The velocity gradients go to the stress buffer: P2G has read
+    /// this step's stresses, and the deformation update turns each gradient into the
+    /// next stress in place, so no buffer of their own is needed (MUSL's re-map
+    /// overwrites them there).
     pub(super) fn grid_to_particles(&mut self, dt: f64) -> Result<(), EngineError> {
-        let in_stress_buffer = self.settings.stress_update == StressUpdate::Usl;
-        if in_stress_buffer {
-            self.stresses_current = false;
-        }
-        let destination = if in_stress_buffer {
-            &mut self.stress_buffer
-        } else {
-            &mut self.velocity_gradients
-        };
-        let mut velocity_gradients = std::mem::take(destination);
+        self.stresses_current = false;
+        let mut velocity_gradients = std::mem::take(&mut self.stress_buffer);
         velocity_gradients.resize(self.particles.len(), SMatrix::zeros());
         let (kernel, transfer, stencils) = (&self.kernel, self.transfer, &self.stencils);
         let grid = GridVelocities {
@@ -266,11 +258,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     })
                 },
             );
-        if in_stress_buffer {
-            self.stress_buffer = velocity_gradients;
-        } else {
-            self.velocity_gradients = velocity_gradients;
-        }
+        self.stress_buffer = velocity_gradients;
         let partials = partials.map_err(|(particle, source)| EngineError::Kernel {
             step,
             particle,

@@ -13,7 +13,8 @@ use crate::transfer::TransferScheme;
 impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
     /// Re-maps the particle momenta with the stencils of the start of the step (stored:
     /// the particles have moved since, so they could not be recomputed) and puts the
-    /// velocity gradients of the re-mapped grid velocity into `self.velocity_gradients`.
+    /// velocity gradients of the re-mapped grid velocity into the stress buffer, over
+    /// G2P's (the deformation update reads them there).
     pub(super) fn musl_velocity_gradients(&mut self) -> Result<(), EngineError> {
         let step = self.step;
         let fail = |(particle, source)| EngineError::Kernel {
@@ -50,7 +51,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             clamp.fit(system, &mut g.velocity);
         }
         let v = &g.velocity;
-        self.velocity_gradients
+        self.stress_buffer
             .par_iter_mut()
             .enumerate()
             .map(|(i, gradient)| {
