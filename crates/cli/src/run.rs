@@ -216,7 +216,8 @@ fn run_dim<const D: usize, X: Dimension<D>>(
         | KernelKind::UmlsWendland
         | KernelKind::UmlsWide
         | KernelKind::UmlsPaper
-        | KernelKind::UmlsFullGradient => {
+        | KernelKind::UmlsFullGradient
+        | KernelKind::UmlsFrozenEta => {
             let mesh = mesh()?;
             let mls = umls_settings(&ctx, &mesh)?;
             with_kernel::<D, X, _>(&ctx, X::Umls::from_mls(mesh, mls))
@@ -302,6 +303,10 @@ fn umls_preset(kind: KernelKind) -> UmlsPreset {
         },
         KernelKind::UmlsFullGradient => UmlsPreset {
             gradient: GradientSpec::Full,
+            ..default
+        },
+        KernelKind::UmlsFrozenEta => UmlsPreset {
+            gradient: GradientSpec::FrozenEta,
             ..default
         },
         _ => default,

@@ -176,6 +176,10 @@ pub enum KernelKind {
     /// gradient (divergence-consistent on unstructured tetrahedra, discontinuous across
     /// facets) instead of the reconstructed one.
     UmlsFullGradient,
+    /// The `umls` kernel with the fit's derivative at frozen diminishing factors η as
+    /// shape-function gradient: the full derivative without ∇η's jump, so continuous
+    /// across facets (docs/umls-kernel.md, *Gradients*).
+    UmlsFrozenEta,
     /// Linear finite-element shape functions on the mesh.
     LinearFe,
     /// Quadratic B-splines on a Cartesian grid covering the mesh.
@@ -194,6 +198,7 @@ impl KernelKind {
             KernelKind::UmlsWide => "umls-wide",
             KernelKind::UmlsPaper => "umls-paper",
             KernelKind::UmlsFullGradient => "umls-full-gradient",
+            KernelKind::UmlsFrozenEta => "umls-frozen-eta",
             KernelKind::LinearFe => "linear-fe",
             KernelKind::Bspline2 => "bspline2",
             KernelKind::Bspline3 => "bspline3",
@@ -280,6 +285,7 @@ impl KernelKind {
                 | KernelKind::UmlsWide
                 | KernelKind::UmlsPaper
                 | KernelKind::UmlsFullGradient
+                | KernelKind::UmlsFrozenEta
         )
     }
 }
@@ -302,6 +308,9 @@ pub enum GradientSpec {
     Reconstructed,
     /// The full derivative of the fit, weights included.
     Full,
+    /// The derivative of the fit with the diminishing factors held fixed: continuous
+    /// across facets.
+    FrozenEta,
 }
 
 impl GradientSpec {
@@ -310,6 +319,7 @@ impl GradientSpec {
         match self {
             Self::Reconstructed => umls_kernels::GradientKind::Reconstructed,
             Self::Full => umls_kernels::GradientKind::Full,
+            Self::FrozenEta => umls_kernels::GradientKind::FrozenEta,
         }
     }
 }

@@ -215,6 +215,7 @@ fn kernel_override_and_conservation() {
         "umls-paper",
         "umls-wendland",
         "umls-full-gradient",
+        "umls-frozen-eta",
     ] {
         let dir = scratch(&format!("disks-{kernel}"));
         let out = umls(&[

@@ -242,8 +242,8 @@ where
     }
 
     /// With the reconstructed gradient: the fit's M⁻¹ and 1/s per particle and its
-    /// weight per ring vertex ([`UmlsFit`]). The full gradient also needs the weights'
-    /// gradients and is not factored.
+    /// weight per ring vertex ([`UmlsFit`]). The full and frozen-η gradients also need
+    /// the weights' gradients and are not factored.
     fn factor_layout(&self) -> Option<FactorLayout> {
         (self.gradient == GradientKind::Reconstructed).then_some(FactorLayout {
             per_particle: UmlsFit::<N>::LEN,
@@ -261,7 +261,7 @@ where
     ) -> Result<(u32, u32), KernelError> {
         if self.factor_layout().is_none() {
             return Err(KernelError::NotFactored {
-                kernel: "UMLS with the full gradient",
+                kernel: "UMLS with the full or frozen-η gradient",
             });
         }
         let located = locate_with_coordinates(&self.mesh, x, cache)?;

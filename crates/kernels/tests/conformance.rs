@@ -54,6 +54,7 @@ proptest! {
         let (lo, hi) = (SVector::<f64, 2>::zeros(), SVector::<f64, 2>::repeat(1.0));
         conformance(&Umls2::new(mesh.clone()), lo, hi, &f)?;
         conformance(&Umls2::new(mesh.clone()).with_gradient(GradientKind::Full), lo, hi, &f)?;
+        conformance(&Umls2::new(mesh.clone()).with_gradient(GradientKind::FrozenEta), lo, hi, &f)?;
         conformance(&LinearFeKernel::new(mesh), lo, hi, &f)?;
         // Same points mapped into the rotated square.
         let mapped: Vec<f64> = f.chunks_exact(2).flat_map(|c| {
@@ -71,6 +72,7 @@ proptest! {
         let (lo, hi) = mesh.bounding_box();
         conformance(&Umls3::new(mesh.clone()), lo, hi, &f)?;
         conformance(&Umls3::new(mesh.clone()).with_gradient(GradientKind::Full), lo, hi, &f)?;
+        conformance(&Umls3::new(mesh.clone()).with_gradient(GradientKind::FrozenEta), lo, hi, &f)?;
         conformance(&LinearFeKernel::new(mesh), lo, hi, &f)?;
     }
 

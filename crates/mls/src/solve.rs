@@ -70,7 +70,8 @@ pub struct Samples<'a, const D: usize> {
     pub positions: &'a [SVector<f64, D>],
     /// Weights w_v(x) ≥ 0.
     pub weights: &'a [f64],
-    /// Weight gradients ∇w_v(x); only read for [`GradientKind::Full`] (may be empty otherwise).
+    /// Weight gradients ∇w_v(x); only read for [`GradientKind::Full`] and
+    /// [`GradientKind::FrozenEta`] (may be empty otherwise).
     pub weight_gradients: &'a [SVector<f64, D>],
 }
 
@@ -88,7 +89,7 @@ pub fn shape_functions<const D: usize, const N: usize, B: PolynomialBasis<D, N>>
     out: &mut Stencil<D>,
 ) -> Result<(), MlsError> {
     let n = samples.positions.len();
-    let needs_weight_gradients = gradient == GradientKind::Full;
+    let needs_weight_gradients = gradient.uses_weight_gradients();
     if samples.weights.len() != n
         || samples.nodes.len() != n
         || (needs_weight_gradients && samples.weight_gradients.len() != n)

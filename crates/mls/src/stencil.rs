@@ -20,6 +20,22 @@ pub enum GradientKind {
     /// The full derivative ∇N_v, including the weights' gradients. Exact derivative of the
     /// shape function; for UMLS it inherits the jump of ∇η across facets.
     Full,
+    /// For UMLS: the derivative of N_v with the diminishing factors η held at their values
+    /// at x, so only the distance weights d_v vary (∇w_v = η_v ∇d_v). Continuous across
+    /// facets, since η is continuous and a vertex whose η vanishes there enters with zero
+    /// weight and zero weight gradient, and exact for linear fields, like the
+    /// reconstructed gradient; it keeps the part of the full derivative that comes from
+    /// the smooth distance weights and leaves out ∇η, the part that jumps. For other
+    /// evaluations the caller's weight gradients are used, as with [`Self::Full`].
+    FrozenEta,
+}
+
+impl GradientKind {
+    /// Whether the weights' gradients enter the shape-function gradient (every kind but
+    /// [`Self::Reconstructed`]).
+    pub fn uses_weight_gradients(self) -> bool {
+        self != Self::Reconstructed
+    }
 }
 
 /// Shape functions of one evaluation point: stencil nodes, N_v and a gradient of N_v.

@@ -207,8 +207,11 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
             let eta = diminishing_factor(mask, lambda.as_slice());
             positions[i] = *xv;
             weights[i] = eta * d;
-            weight_gradients[i] =
-                diminishing_gradient(mask, lambda_gradients.as_slice()) * d + dd * eta;
+            weight_gradients[i] = match gradient {
+                // η frozen at x: only the distance weight varies.
+                GradientKind::FrozenEta => dd * eta,
+                _ => diminishing_gradient(mask, lambda_gradients.as_slice()) * d + dd * eta,
+            };
         }
         let samples = Samples {
             nodes: ring.vertices,
@@ -234,7 +237,7 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
     /// [`SimplexMesh::locate`] and [`SimplexMesh::locate_from`] give them (they are not
     /// computed again; a caller holding only the host builds them with
     /// [`SimplexMesh::barycentric`]). With the reconstructed gradient no array of the fit
-    /// is bounded, so any ring size is accepted; the full gradient keeps the
+    /// is bounded, so any ring size is accepted; the other gradients keep the
     /// [`MAX_STENCIL`] cap. Same values as [`Self::evaluate`], bit for bit; returns the
     /// moment matrix's condition number.
     #[allow(clippy::too_many_arguments)]

@@ -4,7 +4,8 @@
 //! halves when ε halves (ratio jump(2ε)/jump(ε) ≈ 2); a discontinuous one keeps an O(1)
 //! jump (ratio ≈ 1). The UMLS values and reconstructed gradients must be continuous;
 //! linear FE gradients must not be (the cell-crossing baseline); the full UMLS gradient
-//! inherits the jump of ∇η and is reported.
+//! inherits the jump of ∇η and is reported; the derivative at frozen η drops that jump
+//! and must be continuous.
 
 mod common;
 
@@ -332,6 +333,38 @@ fn every_umls_variant_is_continuous() {
             &*umls_evaluator::<3, 10, Quadratic, _>(&tets, &k, GradientKind::Reconstructed),
         ),
     );
+}
+
+/// The derivative at frozen η (`GradientKind::FrozenEta`) keeps only η_v ∇d_v of the
+/// weights' gradients: η is continuous and vanishes with its vertex's entry, ∇d is C¹, so
+/// the gradient is continuous across facets, in 2D and 3D, with the default support and
+/// the wide one, where the full gradient (above) jumps by O(1).
+#[test]
+fn frozen_eta_gradient_is_continuous() {
+    let tets = Lattice::new([0.0; 3], [1.0; 3], [3, 3, 3])
+        .jitter(0.2, 9)
+        .rotate_about([1.0, 1.0, 0.0], 0.4)
+        .tetrahedra()
+        .unwrap();
+    for support in [
+        SupportRadius::default(),
+        SupportRadius::PerVertex { factor: 1.0 },
+    ] {
+        for mesh in meshes_2d() {
+            let k = UmlsKernel::with_weight(&mesh, CubicBSpline, support).unwrap();
+            let s = survey(
+                &mesh,
+                &*umls_evaluator::<2, 3, Linear, _>(&mesh, &k, GradientKind::FrozenEta),
+            );
+            assert_continuous(&format!("2D frozen η, {support:?}"), &s);
+        }
+        let k = UmlsKernel::with_weight(&tets, CubicBSpline, support).unwrap();
+        let s = survey(
+            &tets,
+            &*umls_evaluator::<3, 4, Linear, _>(&tets, &k, GradientKind::FrozenEta),
+        );
+        assert_continuous(&format!("3D frozen η, {support:?}"), &s);
+    }
 }
 
 #[test]

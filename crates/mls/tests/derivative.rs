@@ -1,5 +1,6 @@
 //! The full derivative agrees with central finite differences of the shape functions
-//! inside simplices, for both bases and both weight profiles.
+//! inside simplices, for both bases and both weight profiles; the derivative at frozen η
+//! agrees with central differences of a fit whose diminishing factors are held fixed.
 
 mod common;
 
@@ -7,8 +8,8 @@ use nalgebra::SVector;
 use proptest::prelude::*;
 use umls_mesh::SimplexMesh;
 use umls_mls::{
-    CubicBSpline, GradientKind, Linear, PolynomialBasis, Quadratic, Stencil, SupportRadius,
-    UmlsKernel, WeightFunction, WendlandC2,
+    Conditioning, CubicBSpline, GradientKind, Linear, PolynomialBasis, Quadratic, Samples, Stencil,
+    SupportRadius, UmlsKernel, WeightFunction, WendlandC2, diminishing_factor, shape_functions,
 };
 
 fn check_fd<const D: usize, const N: usize, B: PolynomialBasis<D, N>, W: WeightFunction>(
@@ -102,4 +103,99 @@ fn weight_profile_derivatives() {
     check(WendlandC2);
     assert!((CubicBSpline.evaluate(0.0).0 - 2.0 / 3.0).abs() < 1e-15);
     assert!((CubicBSpline.evaluate(1.0).0 - 1.0 / 6.0).abs() < 1e-15);
+}
+
+/// The derivative at frozen η against central differences of an independent fit: the
+/// public `shape_functions` over the host's 1-ring with weights η_v(x) W(|y − x_v| / h_v),
+/// η computed once at x from the ring's adjacency masks and barycentric coordinates, and
+/// y = x ± δ e_k.
+fn check_frozen_eta_fd<const D: usize, const N: usize, B: PolynomialBasis<D, N>>(
+    mesh: &SimplexMesh<D>,
+    s: usize,
+    raw: &[f64],
+) -> Result<(), TestCaseError> {
+    let kernel = UmlsKernel::new(mesh);
+    let raw: Vec<f64> = raw.iter().map(|r| r + 0.5).collect();
+    let x = common::point_in(mesh, s, &raw);
+    let mut st = Stencil::new();
+    kernel
+        .evaluate::<N, B>(mesh, s as u32, &x, GradientKind::FrozenEta, &mut st)
+        .unwrap();
+    let ring = mesh.topology().one_ring(s);
+    let lambda = mesh.barycentric(s, &x);
+    let eta: Vec<f64> = ring
+        .masks
+        .iter()
+        .map(|&m| diminishing_factor(m, lambda.as_slice()))
+        .collect();
+    let positions: Vec<SVector<f64, D>> = ring
+        .vertices
+        .iter()
+        .map(|&v| *mesh.vertex(v as usize))
+        .collect();
+    let radii = kernel.support_radii();
+    let scale = radii[mesh.simplex(s)[0] as usize];
+    let fit = |y: SVector<f64, D>| {
+        let weights: Vec<f64> = ring
+            .vertices
+            .iter()
+            .zip(&positions)
+            .zip(&eta)
+            .map(|((&v, xv), e)| e * CubicBSpline.evaluate((y - xv).norm() / radii[v as usize]).0)
+            .collect();
+        let samples = Samples {
+            nodes: ring.vertices,
+            positions: &positions,
+            weights: &weights,
+            weight_gradients: &[],
+        };
+        let mut out = Stencil::new();
+        shape_functions::<D, N, B>(
+            &y,
+            &samples,
+            scale,
+            GradientKind::Reconstructed,
+            &Conditioning::default(),
+            &mut out,
+        )
+        .unwrap();
+        out
+    };
+    let at_x = fit(x);
+    for (a, b) in at_x.values().iter().zip(st.values()) {
+        prop_assert!((a - b).abs() < 1e-12, "values differ: {} vs {}", a, b);
+    }
+    let delta = 1e-6 * mesh.max_edge_length();
+    let largest = st.gradients().iter().map(|g| g.norm()).fold(0.0, f64::max);
+    for k in 0..D {
+        let e = SVector::<f64, D>::from_fn(|i, _| if i == k { delta } else { 0.0 });
+        let (plus, minus) = (fit(x + e), fit(x - e));
+        for i in 0..st.len() {
+            let fd = (plus.values()[i] - minus.values()[i]) / (2.0 * delta);
+            prop_assert!(
+                (fd - st.gradients()[i][k]).abs() < 1e-6 * largest,
+                "node {} axis {}: frozen-η gradient {} vs fd {}",
+                st.nodes()[i],
+                k,
+                st.gradients()[i][k],
+                fd
+            );
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    #[test]
+    fn frozen_eta_gradient_matches_fd_of_the_frozen_fit(
+        rect in common::rectangle(),
+        cube in common::fine_cuboid(),
+        s in any::<usize>(),
+        raw in raw_weights(),
+    ) {
+        check_frozen_eta_fd::<2, 3, Linear>(&rect, s % rect.simplex_count(), &raw)?;
+        check_frozen_eta_fd::<3, 4, Linear>(&cube, s % cube.simplex_count(), &raw)?;
+    }
 }

@@ -20,7 +20,11 @@ fn same_as_evaluate<const D: usize, const N: usize, B: PolynomialBasis<D, N>>(
 ) -> Result<(), TestCaseError> {
     let kernel = UmlsKernel::new(mesh);
     let x = common::point_in(mesh, s, raw);
-    for gradient in [GradientKind::Reconstructed, GradientKind::Full] {
+    for gradient in [
+        GradientKind::Reconstructed,
+        GradientKind::Full,
+        GradientKind::FrozenEta,
+    ] {
         let mut stencil = Stencil::new();
         let expected = kernel.evaluate::<N, B>(mesh, s as u32, &x, gradient, &mut stencil);
         let got = common::evaluate_into_vecs::<D, N, B>(&kernel, mesh, s, &x, gradient);

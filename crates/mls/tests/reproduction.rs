@@ -1,5 +1,5 @@
 //! Partition of unity and polynomial reproduction of the UMLS shape functions, for both
-//! gradients, on random jittered and rotated meshes in 1D, 2D and 3D.
+//! gradients (reconstructed, full, at frozen η), on random jittered and rotated meshes in 1D, 2D and 3D.
 
 mod common;
 
@@ -148,6 +148,7 @@ proptest! {
         let s = s % mesh.simplex_count();
         check_linear::<1, 2>(&mesh, s, &raw, GradientKind::Reconstructed)?;
         check_linear::<1, 2>(&mesh, s, &raw, GradientKind::Full)?;
+        check_linear::<1, 2>(&mesh, s, &raw, GradientKind::FrozenEta)?;
     }
 
     #[test]
@@ -155,6 +156,7 @@ proptest! {
         let s = s % mesh.simplex_count();
         check_linear::<2, 3>(&mesh, s, &raw, GradientKind::Reconstructed)?;
         check_linear::<2, 3>(&mesh, s, &raw, GradientKind::Full)?;
+        check_linear::<2, 3>(&mesh, s, &raw, GradientKind::FrozenEta)?;
     }
 
     #[test]
@@ -162,6 +164,7 @@ proptest! {
         let s = s % mesh.simplex_count();
         check_linear::<3, 4>(&mesh, s, &raw, GradientKind::Reconstructed)?;
         check_linear::<3, 4>(&mesh, s, &raw, GradientKind::Full)?;
+        check_linear::<3, 4>(&mesh, s, &raw, GradientKind::FrozenEta)?;
     }
 
     /// Quadratic reproduction on hosts with complete 1-rings (boundary hosts can have too few
@@ -172,6 +175,7 @@ proptest! {
         let s = interior[s % interior.len()];
         check_quadratic::<1, 3>(&mesh, s, &raw, GradientKind::Reconstructed)?;
         check_quadratic::<1, 3>(&mesh, s, &raw, GradientKind::Full)?;
+        check_quadratic::<1, 3>(&mesh, s, &raw, GradientKind::FrozenEta)?;
     }
 
     #[test]
@@ -180,6 +184,7 @@ proptest! {
         let s = interior[s % interior.len()];
         check_quadratic::<2, 6>(&mesh, s, &raw, GradientKind::Reconstructed)?;
         check_quadratic::<2, 6>(&mesh, s, &raw, GradientKind::Full)?;
+        check_quadratic::<2, 6>(&mesh, s, &raw, GradientKind::FrozenEta)?;
     }
 
     #[test]
@@ -188,6 +193,7 @@ proptest! {
         let s = interior[s % interior.len()];
         check_quadratic::<3, 10>(&mesh, s, &raw, GradientKind::Reconstructed)?;
         check_quadratic::<3, 10>(&mesh, s, &raw, GradientKind::Full)?;
+        check_quadratic::<3, 10>(&mesh, s, &raw, GradientKind::FrozenEta)?;
     }
 
     /// Every named variant reproduces linear fields on every host, boundary hosts
