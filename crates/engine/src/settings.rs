@@ -58,7 +58,9 @@ pub enum StencilStorage {
     /// the entries where it has none. About half the stored bytes of UMLS in 3D for
     /// 10–17 % more time per step (docs/scenes.md).
     Factored,
-    /// Evaluate them in P2G and G2P (three evaluations a step with the ordering pass).
+    /// Evaluate them in P2G and G2P (two evaluations a step; the ordering pass asks the
+    /// kernel for each stencil's node range, which mesh and grid kernels know without
+    /// evaluating it).
     Recompute,
 }
 

@@ -121,6 +121,15 @@ fn locate_with_coordinates<const D: usize>(
     Ok(found)
 }
 
+/// The smallest and largest vertex of `simplex`'s 1-ring: a UMLS stencil's node range.
+fn ring_range<const D: usize>(mesh: &SimplexMesh<D>, simplex: u32) -> (u32, u32) {
+    mesh.topology()
+        .one_ring(simplex as usize)
+        .vertices
+        .iter()
+        .fold((u32::MAX, 0), |(l, h), &v| (l.min(v), h.max(v)))
+}
+
 /// The UMLS kernel (C¹ diminishing-weight MLS over the host's 1-ring) as an MPM kernel.
 /// Nodes are the mesh vertices.
 ///
@@ -128,7 +137,8 @@ fn locate_with_coordinates<const D: usize>(
 /// default, which is continuous across facets; [`Self::with_gradient`] selects the full
 /// derivative instead, which differentiates the weights too: it is divergence-consistent
 /// on unstructured tetrahedra where the reconstructed one is not, but it jumps across
-/// facets with the diminishing factor's gradient (docs/umls-kernel.md has both measured).
+/// facets with the diminishing factor's gradient; or the derivative at frozen
+/// diminishing factors, continuous again (docs/umls-kernel.md has all three measured).
 ///
 /// `N` is the size of the polynomial basis `B` (D + 1 for [`Linear`], the default;
 /// (D + 1)(D + 2)/2 for [`umls_mls::Quadratic`]) and `W` the distance-weight profile.
@@ -241,6 +251,21 @@ where
         Ok(())
     }
 
+    /// The host's 1-ring's smallest and largest vertex, without the fit: the engine's
+    /// ordering pass needs only this, so a step with recomputed stencils fits twice
+    /// (P2G and G2P), not three times. A fit that fails (an ill-conditioned moment
+    /// matrix, a ring beyond the full gradient's cap) is reported by the evaluation
+    /// that first makes it, for the same particle.
+    fn node_range(
+        &self,
+        x: &SVector<f64, D>,
+        cache: &mut HostCache,
+        _scratch: &mut Stencil<D>,
+    ) -> Result<(u32, u32), KernelError> {
+        let host = locate(&self.mesh, x, cache)?;
+        Ok(ring_range(&self.mesh, host))
+    }
+
     /// With the reconstructed gradient: the fit's M⁻¹ and 1/s per particle and its
     /// weight per ring vertex ([`UmlsFit`]). The full and frozen-η gradients also need
     /// the weights' gradients and are not factored.
@@ -283,11 +308,7 @@ where
             entries.truncate(start);
             return Err(KernelError::evaluation("UMLS", e));
         }
-        let (low, high) = ring
-            .vertices
-            .iter()
-            .fold((u32::MAX, 0), |(l, h), &v| (l.min(v), h.max(v)));
-        Ok((low, high))
+        Ok(ring_range(&self.mesh, located.simplex))
     }
 
     #[inline(always)]

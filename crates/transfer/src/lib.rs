@@ -186,9 +186,13 @@ pub trait Kernel<const D: usize>: Send + Sync {
     }
 
     /// The smallest and largest node index of the stencil at `x` (the engine orders
-    /// particles by them), failing exactly where [`Self::stencil`] fails. The default
-    /// evaluates the stencil into `scratch`; a kernel that knows the range without the
-    /// values (a grid: the corners of the node block) overrides it.
+    /// particles by them), updating `cache` as [`Self::stencil`] does and failing where
+    /// it cannot locate `x`. The default evaluates the stencil into `scratch`, so it
+    /// fails exactly where [`Self::stencil`] fails; a kernel that knows the range without
+    /// the values (a grid: the corners of the node block; a mesh kernel: the host's
+    /// nodes) overrides it, and may leave a failure of the evaluation itself to the
+    /// evaluation (with recomputed stencils the engine then reports it from P2G, for the
+    /// same particle).
     fn node_range(
         &self,
         x: &SVector<f64, D>,
