@@ -28,16 +28,27 @@ fn check_fd<const D: usize, const N: usize, B: PolynomialBasis<D, N>, W: WeightF
         .evaluate::<N, B>(mesh, s as u32, &x, GradientKind::Full, &mut st)
         .unwrap();
     let delta = 1e-6 * mesh.max_edge_length();
-    let (mut plus, mut minus) = (Stencil::new(), Stencil::new());
+    matches_central_differences(&st, &x, delta, |y| {
+        let mut out = Stencil::new();
+        kernel
+            .evaluate::<N, B>(mesh, s as u32, y, GradientKind::Full, &mut out)
+            .unwrap();
+        out
+    })
+}
+
+/// Every gradient of `st` (evaluated at `x`) against central differences of the values
+/// `eval` gives at x ± δ e_k, relative to the largest gradient.
+fn matches_central_differences<const D: usize>(
+    st: &Stencil<D>,
+    x: &SVector<f64, D>,
+    delta: f64,
+    eval: impl Fn(&SVector<f64, D>) -> Stencil<D>,
+) -> Result<(), TestCaseError> {
+    let scale = st.gradients().iter().map(|g| g.norm()).fold(0.0, f64::max);
     for k in 0..D {
         let e = SVector::<f64, D>::from_fn(|i, _| if i == k { delta } else { 0.0 });
-        kernel
-            .evaluate::<N, B>(mesh, s as u32, &(x + e), GradientKind::Full, &mut plus)
-            .unwrap();
-        kernel
-            .evaluate::<N, B>(mesh, s as u32, &(x - e), GradientKind::Full, &mut minus)
-            .unwrap();
-        let scale = st.gradients().iter().map(|g| g.norm()).fold(0.0, f64::max);
+        let (plus, minus) = (eval(&(x + e)), eval(&(x - e)));
         for i in 0..st.len() {
             let fd = (plus.values()[i] - minus.values()[i]) / (2.0 * delta);
             prop_assert!(
@@ -135,7 +146,7 @@ fn check_frozen_eta_fd<const D: usize, const N: usize, B: PolynomialBasis<D, N>>
         .collect();
     let radii = kernel.support_radii();
     let scale = radii[mesh.simplex(s)[0] as usize];
-    let fit = |y: SVector<f64, D>| {
+    let fit = |y: &SVector<f64, D>| {
         let weights: Vec<f64> = ring
             .vertices
             .iter()
@@ -151,7 +162,7 @@ fn check_frozen_eta_fd<const D: usize, const N: usize, B: PolynomialBasis<D, N>>
         };
         let mut out = Stencil::new();
         shape_functions::<D, N, B>(
-            &y,
+            y,
             &samples,
             scale,
             GradientKind::Reconstructed,
@@ -161,28 +172,10 @@ fn check_frozen_eta_fd<const D: usize, const N: usize, B: PolynomialBasis<D, N>>
         .unwrap();
         out
     };
-    let at_x = fit(x);
-    for (a, b) in at_x.values().iter().zip(st.values()) {
+    for (a, b) in fit(&x).values().iter().zip(st.values()) {
         prop_assert!((a - b).abs() < 1e-12, "values differ: {} vs {}", a, b);
     }
-    let delta = 1e-6 * mesh.max_edge_length();
-    let largest = st.gradients().iter().map(|g| g.norm()).fold(0.0, f64::max);
-    for k in 0..D {
-        let e = SVector::<f64, D>::from_fn(|i, _| if i == k { delta } else { 0.0 });
-        let (plus, minus) = (fit(x + e), fit(x - e));
-        for i in 0..st.len() {
-            let fd = (plus.values()[i] - minus.values()[i]) / (2.0 * delta);
-            prop_assert!(
-                (fd - st.gradients()[i][k]).abs() < 1e-6 * largest,
-                "node {} axis {}: frozen-η gradient {} vs fd {}",
-                st.nodes()[i],
-                k,
-                st.gradients()[i][k],
-                fd
-            );
-        }
-    }
-    Ok(())
+    matches_central_differences(&st, &x, 1e-6 * mesh.max_edge_length(), fit)
 }
 
 proptest! {
