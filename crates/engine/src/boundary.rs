@@ -183,10 +183,12 @@ impl<const D: usize> Boundary<D> {
     /// their normals in the order given: every node ends where [`Self::apply`] puts it.
     /// A pass over the lists when they are sorted already.
     pub(crate) fn sort_by_node(&mut self) {
-        if !self.fixed.is_sorted() {
+        // Checked every step (the lists are public), in parallel: serial, the check of a
+        // box's wall nodes was 1 % of a one-thread B-spline step.
+        if !self.fixed.par_windows(2).all(|w| w[0] <= w[1]) {
             self.fixed.sort_unstable();
         }
-        if !self.slip.is_sorted_by_key(|(node, _)| *node) {
+        if !self.slip.par_windows(2).all(|w| w[0].0 <= w[1].0) {
             self.slip.sort_by_key(|(node, _)| *node);
         }
     }

@@ -178,6 +178,23 @@ impl<const D: usize> Grid<D> {
         )
     }
 
+    /// The lowest node whose updated velocity is not finite. Only chunks marked live can
+    /// hold anything but zeros, so only they are read, in parallel; the lowest chunk's
+    /// first such node is the lowest overall, whatever the thread count.
+    pub fn first_non_finite_velocity(&self) -> Option<usize> {
+        self.new_velocity
+            .par_chunks(NODE_CHUNK)
+            .zip(self.live.par_iter())
+            .enumerate()
+            .filter(|(_, (_, live))| **live)
+            .find_map_first(|(c, (chunk, _))| {
+                chunk
+                    .iter()
+                    .position(|v| !v.iter().all(|x| x.is_finite()))
+                    .map(|i| c * NODE_CHUNK + i)
+            })
+    }
+
     /// Velocities from momenta and forces, damping, boundary conditions.
     pub fn update(
         &mut self,

@@ -588,12 +588,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         self.totals.dropped_mass += report.dropped_mass;
         self.totals.redistributed_momentum += report.redistributed_momentum;
         self.totals.mass_scaled_nodes += report.scaled_nodes;
-        if let Some(node) = self
-            .grid
-            .new_velocity
-            .iter()
-            .position(|v| !v.iter().all(|c| c.is_finite()))
-        {
+        if let Some(node) = self.grid.first_non_finite_velocity() {
             return Err(EngineError::NonFinite {
                 step,
                 field: "velocity",
