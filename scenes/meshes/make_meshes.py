@@ -1,4 +1,11 @@
-"""Regenerates the Gmsh meshes of the built-in scenes (needs `pip install gmsh`)."""
+"""Regenerates the Gmsh meshes of the built-in scenes (needs `pip install gmsh`).
+
+With `--cantilever-refined` it writes instead the cantilever room at h/2, h/3 and h/5
+(cantilever-room-h2.msh, -h3, -h5: triangles of size 0.125, 0.0833, 0.05), the meshes
+of the unstructured cantilever's refinement study (docs/scenes.md); they are not
+committed (4 MB at h/5)."""
+import sys
+
 import gmsh
 
 
@@ -28,13 +35,14 @@ def cantilever():
     gmsh.model.mesh.generate(2)
 
 
-def cantilever_room():
+def cantilever_room(size=0.25):
     """The square room [-3, 7] x [-6, 4] the 4 x 1 cantilever of
     `cantilever-unstructured.toml` swings in, unstructured triangles of size 0.25 (the
-    structured scene's lattice spacing); no groups (the clamp is a region of nodes)."""
+    structured scene's lattice spacing); no groups (the clamp is a region of nodes).
+    Other sizes make the refined meshes of the refinement study in docs/scenes.md."""
     gmsh.model.occ.addRectangle(-3, -6, 0, 10, 10)
     gmsh.model.occ.synchronize()
-    gmsh.model.mesh.setSize(gmsh.model.getEntities(0), 0.25)
+    gmsh.model.mesh.setSize(gmsh.model.getEntities(0), size)
     gmsh.model.mesh.generate(2)
 
 
@@ -82,6 +90,11 @@ def column_3d():
     size 0.2 (the lattice scene's cell)."""
     box_of_tetrahedra(0.2, (1.0, 1.0, 4.4), "box")
 
+
+if "--cantilever-refined" in sys.argv:
+    for factor in (2, 3, 5):
+        mesh(f"cantilever-room-h{factor}", lambda: cantilever_room(0.25 / factor))
+    sys.exit()
 
 mesh("cantilever", cantilever)
 mesh("cantilever-room", cantilever_room)
