@@ -255,7 +255,8 @@ where
     /// ordering pass needs only this, so a step with recomputed stencils fits twice
     /// (P2G and G2P), not three times. A fit that fails (an ill-conditioned moment
     /// matrix, a ring beyond the full gradient's cap) is reported by the evaluation
-    /// that first makes it, for the same particle.
+    /// that first makes it, naming the particle
+    /// (`crates/engine/tests/stencil_storage_errors.rs`).
     fn node_range(
         &self,
         x: &SVector<f64, D>,

@@ -191,8 +191,9 @@ pub trait Kernel<const D: usize>: Send + Sync {
     /// fails exactly where [`Self::stencil`] fails; a kernel that knows the range without
     /// the values (a grid: the corners of the node block; a mesh kernel: the host's
     /// nodes) overrides it, and may leave a failure of the evaluation itself to the
-    /// evaluation (with recomputed stencils the engine then reports it from P2G, for the
-    /// same particle).
+    /// evaluation (with recomputed stencils the engine then reports it from P2G, naming
+    /// the particle whose stencil failed; where several fail, P2G's order decides which
+    /// is named, still the same on any number of threads).
     fn node_range(
         &self,
         x: &SVector<f64, D>,
