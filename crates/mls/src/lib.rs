@@ -5,8 +5,9 @@
 //! x_v with weights w_v ≥ 0 it fits a polynomial of the chosen basis by weighted least
 //! squares around a point x and returns shape functions N_v(x) with either the
 //! reconstructed gradient (the fit's linear coefficients, the default), the full
-//! derivative, or for UMLS the derivative at frozen diminishing factors ([`GradientKind`]). Dimension (1, 2, 3) and basis ([`Linear`],
-//! [`Quadratic`]) are compile-time parameters; an evaluation allocates nothing and fills
+//! derivative, or for UMLS the derivative at frozen diminishing factors
+//! ([`GradientKind`]). Dimension (1, 2, 3) and basis ([`Linear`], [`Quadratic`]) are
+//! compile-time parameters; an evaluation allocates nothing and fills
 //! a fixed-capacity [`Stencil`] on the stack. Ill-conditioned moment matrices fail with a
 //! typed error or are regularised, as the caller chooses ([`Conditioning`]).
 //!

@@ -205,9 +205,9 @@ pub trait Kernel<const D: usize>: Send + Sync {
     }
 
     /// Whether a stencil costs less to evaluate where it is used (P2G and G2P, so twice a
-    /// step besides [`Self::node_range`]) than to store for the step and read back: true for cheap
-    /// closed forms (B-splines), whose stored stencils would be most of a particle's
-    /// memory traffic. The engine follows it unless a setting overrides it. Default:
+    /// step besides [`Self::node_range`]) than to store for the step and read back: true
+    /// for cheap closed forms (B-splines), whose stored stencils would be most of a
+    /// particle's memory traffic. The engine follows it unless a setting overrides it. Default:
     /// false (store).
     fn recompute_stencils(&self) -> bool {
         false
