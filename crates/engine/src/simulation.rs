@@ -536,6 +536,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .compute(
                 &self.kernel,
                 storage,
+                T::AFFINE && self.kernel.constant_second_moment().is_none(),
                 &self.particles.position,
                 &mut self.particles.cache,
             )

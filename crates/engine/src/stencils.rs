@@ -5,7 +5,7 @@
 //! Computed in parallel over fixed chunks, so the result does not depend on the number
 //! of threads; the buffers are reused from step to step.
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 use umls_transfer::{FactorLayout, Kernel, KernelError, Stencil};
 
@@ -29,6 +29,9 @@ struct ChunkStencils<const D: usize> {
     gradients: Vec<SVector<f64, D>>,
     particle_factors: Vec<f64>,
     entry_factors: Vec<f64>,
+    /// Second moments D_p = Σ N_i r_i r_iᵀ of the chunk's stored stencils, when asked
+    /// for ([`Stencils::compute`]).
+    moments: Vec<SMatrix<f64, D, D>>,
     /// The kernel writes here before the entries are appended (or only the range read).
     scratch: Stencil<D>,
 }
@@ -38,7 +41,7 @@ impl<const D: usize> ChunkStencils<D> {
     /// `compute` instead), giving back those it does not use (what an earlier step of
     /// another mode held).
     fn clear_for(&mut self, mode: Mode) {
-        let entries = mode == Mode::Entries;
+        let entries = matches!(mode, Mode::Entries | Mode::EntriesWithMoments);
         let factors = matches!(mode, Mode::Factored(_));
         clear_or_release(&mut self.nodes, entries);
         clear_or_release(&mut self.values, entries);
@@ -50,6 +53,7 @@ impl<const D: usize> ChunkStencils<D> {
         }
         clear_or_release(&mut self.entry_factors, factors);
         clear_or_release(&mut self.offsets, mode != Mode::Recompute);
+        clear_or_release(&mut self.moments, mode == Mode::EntriesWithMoments);
     }
 }
 
@@ -68,6 +72,11 @@ enum Mode {
     /// Node, N and ∇N of every entry.
     #[default]
     Entries,
+    /// The same, and each particle's second moment D_p, which the affine transfers read
+    /// twice a step with a kernel whose D_p varies (P2G's limiter, G2P's C_p): summed
+    /// once here, while the entries and their offsets are in cache, instead of in two
+    /// passes over the stored entries that fetch every node's position again.
+    EntriesWithMoments,
     /// The kernel's factors ([`Kernel::factor_stencil`]).
     Factored(FactorLayout),
     /// Nothing but the node ranges: evaluated where used.
@@ -107,6 +116,23 @@ impl<const D: usize> ParticleStencil<'_, D> {
     }
 }
 
+/// The second moment D_p = Σ N_i r_i r_iᵀ of a particle's stencil at `x`, summed in
+/// entry order (P2G's affine limiter and G2P's C_p both use it, and must agree bit for
+/// bit).
+#[inline]
+pub(crate) fn second_moment<const D: usize, K: Kernel<D>>(
+    st: &ParticleStencil<'_, D>,
+    kernel: &K,
+    x: &SVector<f64, D>,
+) -> SMatrix<f64, D, D> {
+    let mut d = SMatrix::<f64, D, D>::zeros();
+    for e in 0..st.len() {
+        let r = st.offset(e, kernel, x);
+        d += r * r.transpose() * st.values[e];
+    }
+    d
+}
+
 /// What a transfer does with one stencil entry ([`Stencils::visit`]); implementors
 /// mark `entry` `#[inline(always)]`, it runs 9 to 64 times per particle.
 pub(crate) trait EntrySink<const D: usize> {
@@ -125,12 +151,14 @@ pub(crate) struct Stencils<const D: usize> {
 
 impl<const D: usize> Stencils<D> {
     /// Locates every particle (updating its cache) and stores its stencil (entries or
-    /// factors), or with recomputed stencils only its node range. Among failures the
-    /// lowest particle index is reported, whatever the thread count.
+    /// factors), or with recomputed stencils only its node range. With `moments`, stored
+    /// entries come with each particle's second moment D_p ([`Self::second_moment`]).
+    /// Among failures the lowest particle index is reported, whatever the thread count.
     pub fn compute<K: Kernel<D>>(
         &mut self,
         kernel: &K,
         storage: StencilStorage,
+        moments: bool,
         positions: &[SVector<f64, D>],
         caches: &mut [K::Cache],
     ) -> Result<(), (usize, KernelError)> {
@@ -142,6 +170,9 @@ impl<const D: usize> Stencils<D> {
             }
             StencilStorage::Recompute => Mode::Recompute,
         };
+        if self.mode == Mode::Entries && moments {
+            self.mode = Mode::EntriesWithMoments;
+        }
         let mode = self.mode;
         self.chunks
             .resize_with(positions.len().div_ceil(CHUNK), ChunkStencils::default);
@@ -167,6 +198,7 @@ impl<const D: usize> Stencils<D> {
                         gradients,
                         particle_factors,
                         entry_factors,
+                        moments,
                         scratch: st,
                     } = local;
                     for (i, ((x, cache), range)) in
@@ -190,19 +222,31 @@ impl<const D: usize> Stencils<D> {
                                     )
                                     .map_err(fail)?;
                             }
-                            Mode::Entries => {
+                            Mode::Entries | Mode::EntriesWithMoments => {
                                 kernel.stencil(x, cache, st).map_err(fail)?;
                                 *range = st.node_range().unwrap_or((0, 0));
                                 offsets.push(nodes.len());
                                 nodes.extend_from_slice(st.nodes());
                                 values.extend_from_slice(st.values());
                                 gradients.extend_from_slice(st.gradients());
+                                if mode == Mode::EntriesWithMoments {
+                                    moments.push(second_moment(
+                                        &ParticleStencil {
+                                            nodes: st.nodes(),
+                                            values: st.values(),
+                                            gradients: st.gradients(),
+                                            offsets: st.offsets(),
+                                        },
+                                        kernel,
+                                        x,
+                                    ));
+                                }
                             }
                         }
                     }
                     match mode {
                         Mode::Factored(_) => offsets.push(entry_factors.len()),
-                        Mode::Entries => offsets.push(nodes.len()),
+                        Mode::Entries | Mode::EntriesWithMoments => offsets.push(nodes.len()),
                         Mode::Recompute => {}
                     }
                     Ok(())
@@ -224,9 +268,20 @@ impl<const D: usize> Stencils<D> {
                     + bytes(&c.gradients)
                     + bytes(&c.particle_factors)
                     + bytes(&c.entry_factors)
+                    + bytes(&c.moments)
             })
             .sum();
         (stored, bytes(&self.ranges))
+    }
+
+    /// Particle `p`'s second moment D_p = Σ N_i r_i r_iᵀ, if [`Self::compute`] stored it:
+    /// the same bits as [`second_moment`] of the particle's stencil.
+    #[inline]
+    pub fn stored_second_moment(&self, p: usize) -> Option<&SMatrix<f64, D, D>> {
+        if self.mode != Mode::EntriesWithMoments {
+            return None;
+        }
+        Some(&self.chunks[p / CHUNK].moments[p % CHUNK])
     }
 
     /// The smallest and largest node of each particle's stencil.
@@ -285,7 +340,7 @@ impl<const D: usize> Stencils<D> {
         sink: &mut S,
     ) -> Result<(), (usize, KernelError)> {
         match self.mode {
-            Mode::Entries => {
+            Mode::Entries | Mode::EntriesWithMoments => {
                 let (chunk, _, range) = self.stored_entries(p);
                 for e in range {
                     let node = chunk.nodes[e];
@@ -340,7 +395,7 @@ impl<const D: usize> Stencils<D> {
         f: impl FnOnce(ParticleStencil<'_, D>) -> R,
     ) -> Result<R, (usize, KernelError)> {
         match self.mode {
-            Mode::Entries => {
+            Mode::Entries | Mode::EntriesWithMoments => {
                 let (chunk, _, range) = self.stored_entries(p);
                 return Ok(f(ParticleStencil {
                     nodes: &chunk.nodes[range.clone()],

@@ -33,7 +33,9 @@ struct GridVelocities<'a, const D: usize> {
 /// A particle's G2P sums over its stencil.
 struct GatherSums<'a, const D: usize, T> {
     grid: &'a GridVelocities<'a, D>,
-    moment_scale: Option<f64>,
+    /// Whether D_p is summed here (a kernel whose D_p varies, not stored with the
+    /// stencil).
+    sum_moment: bool,
     offsets: bool,
     pic: SVector<f64, D>,
     flip: SVector<f64, D>,
@@ -56,7 +58,7 @@ impl<const D: usize, T: TransferScheme> EntrySink<D> for GatherSums<'_, D, T> {
             self.grad_v += v * gradient.transpose();
         }
         if self.offsets {
-            if self.moment_scale.is_none() {
+            if self.sum_moment {
                 self.d += r * r.transpose() * n;
             }
             if T::USES_MOMENTS {
@@ -84,15 +86,20 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
 ) -> Result<ParticleUpdate<D>, (usize, KernelError)> {
     let moment_scale = kernel.constant_second_moment();
     let offsets = T::AFFINE && (T::USES_MOMENTS || moment_scale.is_none());
+    let stored_moment = stencils.stored_second_moment(p);
     let mut sums = GatherSums::<D, T> {
         grid,
-        moment_scale,
+        sum_moment: moment_scale.is_none() && stored_moment.is_none(),
         offsets,
         pic: SVector::zeros(),
         flip: SVector::zeros(),
         grad_v: SMatrix::zeros(),
         b: SMatrix::zeros(),
-        d: moment_scale.map_or_else(SMatrix::zeros, |s| SMatrix::identity() * s),
+        d: match (moment_scale, stored_moment) {
+            (Some(s), _) => SMatrix::identity() * s,
+            (None, Some(d)) => *d,
+            (None, None) => SMatrix::zeros(),
+        },
         transfer: std::marker::PhantomData,
     };
     stencils.visit(p, kernel, &x, cache, scratch, offsets, &mut sums)?;

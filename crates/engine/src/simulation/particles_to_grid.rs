@@ -9,7 +9,7 @@ use umls_transfer::{Kernel, Stencil};
 use super::Simulation;
 use crate::error::EngineError;
 use crate::scatter::Window;
-use crate::stencils::{EntrySink, ParticleStencil};
+use crate::stencils::{EntrySink, second_moment};
 use crate::transfer::TransferScheme;
 
 /// The affine matrix P2G spreads: C_p, scaled down if its kinetic energy at the
@@ -19,21 +19,15 @@ use crate::transfer::TransferScheme;
 /// moving away from a vertex would carry the affine energy up with it — the energy
 /// source that blew up linear elements with APIC. Skipped where D is not positive
 /// (negative MLS values): there the bound means nothing.
-fn limited_affine<const D: usize, K: Kernel<D>>(
+fn limited_affine<const D: usize>(
     c: &SMatrix<f64, D, D>,
     moment: f64,
-    st: &ParticleStencil<'_, D>,
-    kernel: &K,
-    x: &SVector<f64, D>,
+    d: impl FnOnce() -> SMatrix<f64, D, D>,
 ) -> SMatrix<f64, D, D> {
     if !moment.is_finite() || moment <= 0.0 {
         return if moment == 0.0 { SMatrix::zeros() } else { *c };
     }
-    let mut d = SMatrix::<f64, D, D>::zeros();
-    for e in 0..st.len() {
-        let r = st.offset(e, kernel, x);
-        d += r * r.transpose() * st.values[e];
-    }
+    let d = d();
     let now = (c * d * c.transpose()).trace();
     if now > moment * (1.0 + 1e-9) {
         c * (moment / now).sqrt()
@@ -104,7 +98,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // particle moves, and the limiter has nothing to do.
         let varying_moment = kernel.constant_second_moment().is_none();
         // MLS-MPM's D (checked constant when the simulation starts and every step).
-        let second_moment = kernel.constant_second_moment().unwrap_or(f64::NAN);
+        let constant_moment = kernel.constant_second_moment().unwrap_or(f64::NAN);
         let dt = self.dt;
         let ranges = stencils.ranges();
         self.scatter
@@ -127,11 +121,13 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         acceleration,
                         transfer: std::marker::PhantomData::<T>,
                     };
-                    if T::AFFINE && varying_moment {
+                    let stored_moment = stencils.stored_second_moment(i);
+                    if T::AFFINE && varying_moment && stored_moment.is_none() {
                         // The limiter reads the whole stencil before the first entry.
                         stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
-                            sink.affine =
-                                limited_affine(&p.affine[i], p.affine_moment[i], &st, kernel, &x);
+                            sink.affine = limited_affine(&p.affine[i], p.affine_moment[i], || {
+                                second_moment(&st, kernel, &x)
+                            });
                             for e in 0..st.len() {
                                 let r = st.offset(e, kernel, &x);
                                 sink.entry(st.nodes[e], st.values[e], &st.gradients[e], &r);
@@ -141,9 +137,13 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         if T::FUSED_FORCE {
                             // MLS-MPM: ∇N_i ≈ D⁻¹ N_i r_i folds the stress impulse into
                             // the affine term, and gravity into the momentum.
-                            let inverse_moment = 1.0 / second_moment;
+                            let inverse_moment = 1.0 / constant_moment;
                             sink.affine = p.affine[i] * m - stress_volume * (dt * inverse_moment);
                             sink.velocity = (v + acceleration * dt) * m;
+                        } else if let Some(d) = stored_moment.filter(|_| T::AFFINE) {
+                            // D_p summed with the stencil ([`Stencils::compute`]): the
+                            // entries are visited once.
+                            sink.affine = limited_affine(&p.affine[i], p.affine_moment[i], || *d);
                         } else if T::AFFINE {
                             sink.affine = p.affine[i];
                         }
