@@ -152,8 +152,9 @@ pub(crate) struct Stencils<const D: usize> {
 impl<const D: usize> Stencils<D> {
     /// Locates every particle (updating its cache) and stores its stencil (entries or
     /// factors), or with recomputed stencils only its node range. With `moments`, stored
-    /// entries come with each particle's second moment D_p ([`Self::second_moment`]).
-    /// Among failures the lowest particle index is reported, whatever the thread count.
+    /// entries come with each particle's second moment D_p
+    /// ([`Self::stored_second_moment`]). Among failures the lowest particle index is
+    /// reported, whatever the thread count.
     pub fn compute<K: Kernel<D>>(
         &mut self,
         kernel: &K,
