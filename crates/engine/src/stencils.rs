@@ -94,7 +94,18 @@ pub(crate) struct ParticleStencil<'a, const D: usize> {
     offsets: &'a [SVector<f64, D>],
 }
 
-impl<const D: usize> ParticleStencil<'_, D> {
+impl<'a, const D: usize> ParticleStencil<'a, D> {
+    /// The entries a kernel evaluated into `st`, offsets included.
+    #[inline]
+    fn of(st: &'a Stencil<D>) -> Self {
+        Self {
+            nodes: st.nodes(),
+            values: st.values(),
+            gradients: st.gradients(),
+            offsets: st.offsets(),
+        }
+    }
+
     /// Number of nodes.
     #[inline]
     pub fn len(&self) -> usize {
@@ -232,12 +243,7 @@ impl<const D: usize> Stencils<D> {
                                 gradients.extend_from_slice(st.gradients());
                                 if mode == Mode::EntriesWithMoments {
                                     moments.push(second_moment(
-                                        &ParticleStencil {
-                                            nodes: st.nodes(),
-                                            values: st.values(),
-                                            gradients: st.gradients(),
-                                            offsets: st.offsets(),
-                                        },
+                                        &ParticleStencil::of(st),
                                         kernel,
                                         x,
                                     ));
@@ -422,11 +428,6 @@ impl<const D: usize> Stencils<D> {
                 kernel.stencil(x, &mut cache, scratch).map_err(|e| (p, e))?;
             }
         }
-        Ok(f(ParticleStencil {
-            nodes: scratch.nodes(),
-            values: scratch.values(),
-            gradients: scratch.gradients(),
-            offsets: scratch.offsets(),
-        }))
+        Ok(f(ParticleStencil::of(scratch)))
     }
 }
