@@ -128,14 +128,25 @@ trait FromMls<const D: usize> {
         mesh: Arc<SimplexMesh<D>>,
         settings: (UmlsKernel<D, Profile>, GradientKind),
     ) -> Self;
+
+    /// The kernel with its force's integration correction.
+    fn with_integration_correction(self) -> std::result::Result<Self, umls_transfer::KernelError>
+    where
+        Self: Sized;
 }
 
-impl<const D: usize, const N: usize, B> FromMls<D> for UmlsMeshKernel<D, N, B, Profile> {
+impl<const D: usize, const N: usize, B: umls_mls::PolynomialBasis<D, N>> FromMls<D>
+    for UmlsMeshKernel<D, N, B, Profile>
+{
     fn from_mls(
         mesh: Arc<SimplexMesh<D>>,
         (mls, gradient): (UmlsKernel<D, Profile>, GradientKind),
     ) -> Self {
         Self::with_kernel(mesh, mls).with_gradient(gradient)
+    }
+
+    fn with_integration_correction(self) -> std::result::Result<Self, umls_transfer::KernelError> {
+        UmlsMeshKernel::with_integration_correction(self)
     }
 }
 
@@ -217,15 +228,18 @@ fn run_dim<const D: usize, X: Dimension<D>>(
         | KernelKind::UmlsWide
         | KernelKind::UmlsPaper
         | KernelKind::UmlsFullGradient
-        | KernelKind::UmlsFrozenEta => {
+        | KernelKind::UmlsFrozenEta
+        | KernelKind::UmlsVci => {
             let mesh = mesh()?;
             let mls = umls_settings(&ctx, &mesh)?;
-            with_kernel::<D, X, _>(&ctx, X::Umls::from_mls(mesh, mls))
+            let kernel = corrected(&ctx, X::Umls::from_mls(mesh, mls))?;
+            with_kernel::<D, X, _>(&ctx, kernel)
         }
         KernelKind::UmlsQuadratic => {
             let mesh = mesh()?;
             let mls = umls_settings(&ctx, &mesh)?;
-            with_kernel::<D, X, _>(&ctx, X::UmlsQuadratic::from_mls(mesh, mls))
+            let kernel = corrected(&ctx, X::UmlsQuadratic::from_mls(mesh, mls))?;
+            with_kernel::<D, X, _>(&ctx, kernel)
         }
         KernelKind::LinearFe => with_kernel::<D, X, _>(&ctx, LinearFeKernel::new(mesh()?)),
         KernelKind::Bspline2 => {
@@ -233,6 +247,22 @@ fn run_dim<const D: usize, X: Dimension<D>>(
         }
         KernelKind::Bspline3 => with_kernel::<D, X, _>(&ctx, bspline(&ctx, BSplineOrder::Cubic)?),
     }
+}
+
+/// The UMLS kernel with its force's integration correction where `[kernel]
+/// integration_correction` (or the kernel name, `umls-vci`) asks for it.
+fn corrected<const D: usize, K: FromMls<D>>(ctx: &Context<'_, D>, kernel: K) -> Result<K> {
+    let spec = &ctx.scene.spec.kernel;
+    if !spec
+        .integration_correction
+        .unwrap_or(ctx.kernel == KernelKind::UmlsVci)
+    {
+        return Ok(kernel);
+    }
+    kernel.with_integration_correction().map_err(|e| {
+        ctx.scene
+            .value_error("kernel.integration_correction", e.to_string())
+    })
 }
 
 /// The MLS settings of a UMLS kernel and its gradient kind: the kernel name's preset

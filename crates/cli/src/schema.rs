@@ -180,6 +180,10 @@ pub enum KernelKind {
     /// shape-function gradient: the full derivative without ∇η's jump, so continuous
     /// across facets (docs/umls-kernel.md, *Gradients*).
     UmlsFrozenEta,
+    /// The `umls` kernel with its force's gradients corrected node by node, by vectors
+    /// fitted once over the mesh, to integrate like the derivative of N_i (variationally
+    /// consistent integration; docs/umls-kernel.md, *Integration correction*).
+    UmlsVci,
     /// Linear finite-element shape functions on the mesh.
     LinearFe,
     /// Quadratic B-splines on a Cartesian grid covering the mesh.
@@ -199,6 +203,7 @@ impl KernelKind {
             KernelKind::UmlsPaper => "umls-paper",
             KernelKind::UmlsFullGradient => "umls-full-gradient",
             KernelKind::UmlsFrozenEta => "umls-frozen-eta",
+            KernelKind::UmlsVci => "umls-vci",
             KernelKind::LinearFe => "linear-fe",
             KernelKind::Bspline2 => "bspline2",
             KernelKind::Bspline3 => "bspline3",
@@ -224,6 +229,10 @@ pub struct KernelSpec {
     pub support_factor: Option<f64>,
     /// UMLS kernels: which shape-function gradient (default: the kernel name's).
     pub gradient: Option<GradientSpec>,
+    /// UMLS kernels: whether the force's gradients are corrected node by node to
+    /// integrate like the fit's full derivative (default: the kernel name's; `umls-vci`
+    /// corrects). Kernels whose gradient is their derivative are unchanged by it.
+    pub integration_correction: Option<bool>,
     /// Whether stencils are stored for the step or recomputed where used (default: the
     /// kernel's choice, `auto`).
     #[serde(default)]
@@ -286,6 +295,7 @@ impl KernelKind {
                 | KernelKind::UmlsPaper
                 | KernelKind::UmlsFullGradient
                 | KernelKind::UmlsFrozenEta
+                | KernelKind::UmlsVci
         )
     }
 }

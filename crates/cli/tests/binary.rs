@@ -216,6 +216,7 @@ fn kernel_override_and_conservation() {
         "umls-wendland",
         "umls-full-gradient",
         "umls-frozen-eta",
+        "umls-vci",
     ] {
         let dir = scratch(&format!("disks-{kernel}"));
         let out = umls(&[

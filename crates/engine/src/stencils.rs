@@ -32,6 +32,9 @@ struct ChunkStencils<const D: usize> {
     /// Second moments D_p = Σ N_i r_i r_iᵀ of the chunk's stored stencils, when asked
     /// for ([`Stencils::compute`]).
     moments: Vec<SMatrix<f64, D, D>>,
+    /// ξ̄_p = Σ N_i ξ_i of the chunk's stored stencils under the kernel's integration
+    /// correction ξ, when it has one ([`Stencils::compute`]).
+    correction_means: Vec<SVector<f64, D>>,
     /// The kernel writes here before the entries are appended (or only the range read).
     scratch: Stencil<D>,
 }
@@ -54,6 +57,8 @@ impl<const D: usize> ChunkStencils<D> {
         clear_or_release(&mut self.entry_factors, factors);
         clear_or_release(&mut self.offsets, mode != Mode::Recompute);
         clear_or_release(&mut self.moments, mode == Mode::EntriesWithMoments);
+        // Cleared here, filled by `compute` when the kernel has a correction.
+        self.correction_means.clear();
     }
 }
 
@@ -144,6 +149,21 @@ pub(crate) fn second_moment<const D: usize, K: Kernel<D>>(
     d
 }
 
+/// ξ̄_p = Σ_i N_i ξ_i over a particle's stencil, the mean the integration correction
+/// subtracts ([`Kernel::force_gradient_correction`]), summed in entry order wherever it
+/// is taken (the stencil stage for stored entries, P2G otherwise: the same bits).
+#[inline]
+pub(crate) fn correction_mean<const D: usize>(
+    st: &ParticleStencil<'_, D>,
+    xi: &[SVector<f64, D>],
+) -> SVector<f64, D> {
+    let mut mean = SVector::<f64, D>::zeros();
+    for e in 0..st.len() {
+        mean += xi[st.nodes[e] as usize] * st.values[e];
+    }
+    mean
+}
+
 /// What a transfer does with one stencil entry ([`Stencils::visit`]); implementors
 /// mark `entry` `#[inline(always)]`, it runs 9 to 64 times per particle.
 pub(crate) trait EntrySink<const D: usize> {
@@ -164,8 +184,9 @@ impl<const D: usize> Stencils<D> {
     /// Locates every particle (updating its cache) and stores its stencil (entries or
     /// factors), or with recomputed stencils only its node range. With `moments`, stored
     /// entries come with each particle's second moment D_p
-    /// ([`Self::stored_second_moment`]). Among failures the lowest particle index is
-    /// reported, whatever the thread count.
+    /// ([`Self::stored_second_moment`]), and under a kernel's integration correction with
+    /// each particle's ξ̄_p ([`Self::stored_correction_mean`]). Among failures the lowest
+    /// particle index is reported, whatever the thread count.
     pub fn compute<K: Kernel<D>>(
         &mut self,
         kernel: &K,
@@ -186,6 +207,7 @@ impl<const D: usize> Stencils<D> {
             self.mode = Mode::EntriesWithMoments;
         }
         let mode = self.mode;
+        let correction = kernel.force_gradient_correction();
         self.chunks
             .resize_with(positions.len().div_ceil(CHUNK), ChunkStencils::default);
         self.ranges.resize(positions.len(), (0, 0));
@@ -211,6 +233,7 @@ impl<const D: usize> Stencils<D> {
                         particle_factors,
                         entry_factors,
                         moments,
+                        correction_means,
                         scratch: st,
                     } = local;
                     for (i, ((x, cache), range)) in
@@ -248,6 +271,10 @@ impl<const D: usize> Stencils<D> {
                                         x,
                                     ));
                                 }
+                                if let Some(xi) = correction {
+                                    correction_means
+                                        .push(correction_mean(&ParticleStencil::of(st), xi));
+                                }
                             }
                         }
                     }
@@ -276,6 +303,7 @@ impl<const D: usize> Stencils<D> {
                     + bytes(&c.particle_factors)
                     + bytes(&c.entry_factors)
                     + bytes(&c.moments)
+                    + bytes(&c.correction_means)
             })
             .sum();
         (stored, bytes(&self.ranges))
@@ -289,6 +317,14 @@ impl<const D: usize> Stencils<D> {
             return None;
         }
         Some(&self.chunks[p / CHUNK].moments[p % CHUNK])
+    }
+
+    /// Particle `p`'s ξ̄_p under the kernel's integration correction, if [`Self::compute`]
+    /// stored it (stored entries of a kernel with a correction): the same bits as
+    /// [`correction_mean`] of the particle's stencil.
+    #[inline]
+    pub fn stored_correction_mean(&self, p: usize) -> Option<&SVector<f64, D>> {
+        self.chunks[p / CHUNK].correction_means.get(p % CHUNK)
     }
 
     /// The smallest and largest node of each particle's stencil.

@@ -209,7 +209,15 @@ fn three_dimensional_runs_are_bitwise_independent_of_the_thread_count() {
             .tetrahedra()
             .unwrap(),
     );
-    assert_thread_independent("umls 3D", Umls3::new(mesh), 0.0195, 5, true);
+    assert_thread_independent("umls 3D", Umls3::new(mesh.clone()), 0.0195, 5, true);
+    let corrected = Umls3::new(mesh).with_integration_correction().unwrap();
+    assert_thread_independent(
+        "umls 3D, integration correction",
+        corrected,
+        0.0195,
+        5,
+        true,
+    );
     let grid = BSplineKernel::new(
         Vector3::from_element(-0.2),
         0.1,

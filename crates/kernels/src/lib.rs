@@ -1,7 +1,10 @@
 //! MPM shape-function kernels behind the [`umls_transfer::Kernel`] port:
 //!
 //! - `UmlsMeshKernel` (`Umls1`, `Umls2`, `Umls3`): the C¹ UMLS kernel on a
-//!   simplicial mesh (umls-mls + umls-mesh; feature `mesh`, on by default);
+//!   simplicial mesh (umls-mls + umls-mesh; feature `mesh`, on by default), with an
+//!   optional integration correction of its force gradients fitted once over the mesh
+//!   (`UmlsMeshKernel::with_integration_correction`; rayon integrates the mesh in
+//!   parallel, which is why the feature pulls it);
 //! - `LinearFeKernel`: P1 hat functions on the same mesh, the classic unstructured MPM
 //!   with cell-crossing error (feature `mesh`);
 //! - [`BSplineKernel`]: quadratic or cubic B-splines on a Cartesian grid, the
@@ -33,6 +36,8 @@
 //! ```
 
 mod bspline;
+#[cfg(feature = "mesh")]
+mod integration_correction;
 #[cfg(feature = "mesh")]
 mod mesh_kernels;
 

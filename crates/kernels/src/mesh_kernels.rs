@@ -152,6 +152,9 @@ where
     mesh: Arc<SimplexMesh<D>>,
     kernel: UmlsKernel<D, W>,
     gradient: GradientKind,
+    /// The force's integration correction ξ_i per vertex, if asked for
+    /// ([`Self::with_integration_correction`]).
+    correction: Option<Arc<[SVector<f64, D>]>>,
     basis: PhantomData<fn() -> B>,
 }
 
@@ -182,6 +185,7 @@ impl<const D: usize, const N: usize, B, W: WeightFunction> UmlsMeshKernel<D, N, 
             mesh,
             kernel,
             gradient: GradientKind::Reconstructed,
+            correction: None,
             basis: PhantomData,
         }
     }
@@ -190,7 +194,36 @@ impl<const D: usize, const N: usize, B, W: WeightFunction> UmlsMeshKernel<D, N, 
     #[must_use]
     pub fn with_gradient(mut self, gradient: GradientKind) -> Self {
         self.gradient = gradient;
+        // A correction fitted for another gradient no longer applies.
+        self.correction = None;
         self
+    }
+
+    /// The same kernel with the force's gradients corrected to ∇N_i + N_i ξ_i, with ξ_i
+    /// fitted over the mesh so that every vertex's corrected gradient integrates like the
+    /// derivative of N_i (integration correction; the velocity gradient keeps the
+    /// stencils' own). Costs one fit at 3^D points of every simplex (2^D in 3D) and a few
+    /// of every boundary facet, once, in parallel. Nothing to
+    /// correct with the full derivative. Fails where a fit fails.
+    pub fn with_integration_correction(mut self) -> Result<Self, KernelError>
+    where
+        B: PolynomialBasis<D, N>,
+    {
+        self.correction = Some(
+            crate::integration_correction::node_corrections::<D, N, B, W>(
+                &self.mesh,
+                &self.kernel,
+                self.gradient,
+                crate::integration_correction::points_per_axis(D),
+            )?
+            .into(),
+        );
+        Ok(self)
+    }
+
+    /// The force's integration correction ξ_i per vertex, if the kernel has one.
+    pub fn integration_correction(&self) -> Option<&[SVector<f64, D>]> {
+        self.correction.as_deref()
     }
 
     /// Which gradient the stencils carry.
@@ -265,6 +298,10 @@ where
     ) -> Result<(u32, u32), KernelError> {
         let host = locate(&self.mesh, x, cache)?;
         Ok(ring_range(&self.mesh, host))
+    }
+
+    fn force_gradient_correction(&self) -> Option<&[SVector<f64, D>]> {
+        self.correction.as_deref()
     }
 
     /// With the reconstructed gradient: the fit's M⁻¹ and 1/s per particle and its

@@ -272,6 +272,15 @@ pub trait Kernel<const D: usize>: Send + Sync {
         None
     }
 
+    /// Per-node vectors ξ_i with which the internal force's shape-function gradients
+    /// become ∇N_i + N_i ξ_i (an integration correction the kernel computed over its
+    /// domain, for a gradient that is not the derivative of N_i, such as an MLS fit's
+    /// reconstructed gradient), indexed by node; `None` (the default) for none. The
+    /// velocity gradient keeps ∇N_i, which reproduces affine fields.
+    fn force_gradient_correction(&self) -> Option<&[SVector<f64, D>]> {
+        None
+    }
+
     /// If `x` lies outside the domain, where it left it, seen from the location in
     /// `cache` (`None` inside, or where the kernel cannot tell). Mesh kernels use it to
     /// hold particles at walls given as boundary node sets. Default: `None`.

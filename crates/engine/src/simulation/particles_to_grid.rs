@@ -9,7 +9,7 @@ use umls_transfer::{Kernel, Stencil};
 use super::Simulation;
 use crate::error::EngineError;
 use crate::scatter::Window;
-use crate::stencils::{EntrySink, second_moment};
+use crate::stencils::{EntrySink, correction_mean, second_moment};
 use crate::transfer::TransferScheme;
 
 /// The affine matrix P2G spreads: C_p, scaled down if its kinetic energy at the
@@ -47,6 +47,12 @@ struct ScatterEntry<'w, const D: usize, T> {
     /// Kirchhoff stress times the current volume.
     stress_volume: SMatrix<f64, D, D>,
     acceleration: SVector<f64, D>,
+    /// The kernel's integration correction ξ_i per node, if it has one: the force's
+    /// gradient is ∇N_i + N_i (ξ_i − ξ̄_p) ([`Kernel::force_gradient_correction`]).
+    correction: Option<&'w [SVector<f64, D>]>,
+    /// ξ̄_p = Σ_i N_i ξ_i at the particle, which makes the corrections sum to zero over
+    /// its stencil, so the internal forces still sum to zero (momentum is conserved).
+    correction_mean: SVector<f64, D>,
     transfer: std::marker::PhantomData<T>,
 }
 
@@ -65,6 +71,14 @@ impl<const D: usize, T: TransferScheme> EntrySink<D> for ScatterEntry<'_, D, T> 
         if T::AFFINE {
             mv += self.affine * r;
         }
+        let corrected;
+        let gradient = match self.correction {
+            Some(xi) => {
+                corrected = gradient + (xi[node as usize] - self.correction_mean) * n;
+                &corrected
+            }
+            None => gradient,
+        };
         self.window.add(
             node as usize,
             n * m,
@@ -101,6 +115,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let constant_moment = kernel.constant_second_moment().unwrap_or(f64::NAN);
         let dt = self.dt;
         let ranges = stencils.ranges();
+        let correction = kernel.force_gradient_correction();
         self.scatter
             .scatter(ranges, sums, |block, window| {
                 let mut scratch = Stencil::new();
@@ -119,8 +134,20 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         volume,
                         stress_volume,
                         acceleration,
+                        correction,
+                        correction_mean: SVector::zeros(),
                         transfer: std::marker::PhantomData::<T>,
                     };
+                    if let Some(xi) = correction {
+                        sink.correction_mean = match stencils.stored_correction_mean(i) {
+                            Some(mean) => *mean,
+                            None => {
+                                stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
+                                    correction_mean(&st, xi)
+                                })?
+                            }
+                        };
+                    }
                     let stored_moment = stencils.stored_second_moment(i);
                     if T::AFFINE && varying_moment && stored_moment.is_none() {
                         // The limiter reads the whole stencil before the first entry.
