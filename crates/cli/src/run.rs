@@ -229,7 +229,7 @@ fn run_dim<const D: usize, X: Dimension<D>>(
         | KernelKind::UmlsPaper
         | KernelKind::UmlsFullGradient
         | KernelKind::UmlsFrozenEta
-        | KernelKind::UmlsVci => {
+        | KernelKind::UmlsUncorrected => {
             let mesh = mesh()?;
             let mls = umls_settings(&ctx, &mesh)?;
             let kernel = corrected(&ctx, X::Umls::from_mls(mesh, mls))?;
@@ -250,12 +250,12 @@ fn run_dim<const D: usize, X: Dimension<D>>(
 }
 
 /// The UMLS kernel with its force's integration correction where `[kernel]
-/// integration_correction` (or the kernel name, `umls-vci`) asks for it.
+/// integration_correction` (or the kernel name: `umls` corrects) asks for it.
 fn corrected<const D: usize, K: FromMls<D>>(ctx: &Context<'_, D>, kernel: K) -> Result<K> {
     let spec = &ctx.scene.spec.kernel;
     if !spec
         .integration_correction
-        .unwrap_or(ctx.kernel == KernelKind::UmlsVci)
+        .unwrap_or(ctx.kernel == KernelKind::Umls)
     {
         return Ok(kernel);
     }
@@ -308,7 +308,8 @@ struct UmlsPreset {
 }
 
 /// Profile, radius rule, factor and gradient of each UMLS kernel name: the default
-/// `umls` with the one part the name changes.
+/// `umls` with the one part the name changes (whether the force's gradients are
+/// corrected is decided by [`corrected`]: only `umls` is, by default).
 fn umls_preset(kind: KernelKind) -> UmlsPreset {
     let default = UmlsPreset {
         weight: WeightSpec::CubicBspline,

@@ -160,7 +160,10 @@ pub struct LatticeSpec {
 #[serde(rename_all = "kebab-case")]
 pub enum KernelKind {
     /// C¹ UMLS kernel on the mesh: linear basis, cubic B-spline weights with the
-    /// incident-edge support radius (docs/umls-kernel.md has the study that chose it).
+    /// incident-edge support radius, and the integration correction of its force
+    /// gradients (docs/umls-kernel.md has the studies that chose them). The other UMLS
+    /// names change one part of `umls-uncorrected`, the kernel their studies measured
+    /// against; `[kernel] integration_correction = true` corrects any of them.
     #[default]
     Umls,
     /// UMLS with the quadratic basis on the 1-ring (ridge on the quadratic terms).
@@ -180,10 +183,9 @@ pub enum KernelKind {
     /// shape-function gradient: the full derivative without ∇η's jump, so continuous
     /// across facets (docs/umls-kernel.md, *Gradients*).
     UmlsFrozenEta,
-    /// The `umls` kernel with its force's gradients corrected node by node, by vectors
-    /// fitted once over the mesh, to integrate like the derivative of N_i (variationally
-    /// consistent integration; docs/umls-kernel.md, *Integration correction*).
-    UmlsVci,
+    /// The `umls` kernel without the integration correction of its force gradients: the
+    /// default before the correction (docs/umls-kernel.md, *Integration correction*).
+    UmlsUncorrected,
     /// Linear finite-element shape functions on the mesh.
     LinearFe,
     /// Quadratic B-splines on a Cartesian grid covering the mesh.
@@ -203,7 +205,7 @@ impl KernelKind {
             KernelKind::UmlsPaper => "umls-paper",
             KernelKind::UmlsFullGradient => "umls-full-gradient",
             KernelKind::UmlsFrozenEta => "umls-frozen-eta",
-            KernelKind::UmlsVci => "umls-vci",
+            KernelKind::UmlsUncorrected => "umls-uncorrected",
             KernelKind::LinearFe => "linear-fe",
             KernelKind::Bspline2 => "bspline2",
             KernelKind::Bspline3 => "bspline3",
@@ -230,8 +232,9 @@ pub struct KernelSpec {
     /// UMLS kernels: which shape-function gradient (default: the kernel name's).
     pub gradient: Option<GradientSpec>,
     /// UMLS kernels: whether the force's gradients are corrected node by node to
-    /// integrate like the fit's full derivative (default: the kernel name's; `umls-vci`
-    /// corrects). Kernels whose gradient is their derivative are unchanged by it.
+    /// integrate like the fit's full derivative (default: the kernel name's; `umls`
+    /// corrects, the other names do not). Kernels whose gradient is their derivative
+    /// are unchanged by it.
     pub integration_correction: Option<bool>,
     /// Whether stencils are stored for the step or recomputed where used (default: the
     /// kernel's choice, `auto`).
@@ -295,7 +298,7 @@ impl KernelKind {
                 | KernelKind::UmlsPaper
                 | KernelKind::UmlsFullGradient
                 | KernelKind::UmlsFrozenEta
-                | KernelKind::UmlsVci
+                | KernelKind::UmlsUncorrected
         )
     }
 }

@@ -216,7 +216,7 @@ fn kernel_override_and_conservation() {
         "umls-wendland",
         "umls-full-gradient",
         "umls-frozen-eta",
-        "umls-vci",
+        "umls-uncorrected",
     ] {
         let dir = scratch(&format!("disks-{kernel}"));
         let out = umls(&[

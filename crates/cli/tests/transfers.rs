@@ -11,7 +11,7 @@ use runs::{metric, options, variant};
 /// At α = 0.99 the PIC part of FLIP is what dissipates (pure FLIP loses 3 % with UMLS
 /// and under 1 % with bspline2 by t = 3); with the affine field carried through P2G it
 /// filters only what that field does not hold, so APIC-FLIP loses less for every
-/// kernel. Measured by t = 3: UMLS 0.325 → 0.255, bspline2 0.186 → 0.100.
+/// kernel. Measured by t = 3: UMLS 0.317 → 0.247, bspline2 0.186 → 0.100.
 #[test]
 fn apic_flip_loses_less_energy_than_flip_on_the_disks() {
     let lost = |kernel: KernelKind, kind: &str| {
@@ -41,7 +41,7 @@ fn apic_flip_loses_less_energy_than_flip_on_the_disks() {
 
 /// `[transfer] mass = { iterations = 2 }`: the consistent mass matrix in the velocity
 /// keeps what APIC's lumped round trip filters out of the ringing disks (measured by
-/// t = 3: UMLS 0.864 → 0.209, bspline2 0.700 → 0.131), the summary names it, and MLS-MPM,
+/// t = 3: UMLS 0.860 → 0.201, bspline2 0.700 → 0.131), the summary names it, and MLS-MPM,
 /// whose momenta carry the force impulse, refuses it by name.
 #[test]
 fn consistent_mass_keeps_the_disks_energy_under_apic() {

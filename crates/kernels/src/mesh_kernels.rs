@@ -139,6 +139,9 @@ fn ring_range<const D: usize>(mesh: &SimplexMesh<D>, simplex: u32) -> (u32, u32)
 /// on unstructured tetrahedra where the reconstructed one is not, but it jumps across
 /// facets with the diminishing factor's gradient; or the derivative at frozen
 /// diminishing factors, continuous again (docs/umls-kernel.md has all three measured).
+/// [`Self::with_integration_correction`] corrects the internal force's gradients so that
+/// they integrate like the derivative (the command line's default `umls` kernel is the
+/// reconstructed gradient with it).
 ///
 /// `N` is the size of the polynomial basis `B` (D + 1 for [`Linear`], the default;
 /// (D + 1)(D + 2)/2 for [`umls_mls::Quadratic`]) and `W` the distance-weight profile.
@@ -203,21 +206,25 @@ impl<const D: usize, const N: usize, B, W: WeightFunction> UmlsMeshKernel<D, N, 
     /// fitted over the mesh so that every vertex's corrected gradient integrates like the
     /// derivative of N_i (integration correction; the velocity gradient keeps the
     /// stencils' own). Costs one fit at 3^D points of every simplex (2^D in 3D) and a few
-    /// of every boundary facet, once, in parallel. Nothing to
-    /// correct with the full derivative. Fails where a fit fails.
+    /// of every boundary facet, once, in parallel. The full derivative needs no
+    /// correction: with it the kernel stays uncorrected. Fails where a fit fails.
     pub fn with_integration_correction(mut self) -> Result<Self, KernelError>
     where
         B: PolynomialBasis<D, N>,
     {
-        self.correction = Some(
-            crate::integration_correction::node_corrections::<D, N, B, W>(
-                &self.mesh,
-                &self.kernel,
-                self.gradient,
-                crate::integration_correction::points_per_axis(D),
-            )?
-            .into(),
-        );
+        self.correction = if self.gradient == GradientKind::Full {
+            None
+        } else {
+            Some(
+                crate::integration_correction::node_corrections::<D, N, B, W>(
+                    &self.mesh,
+                    &self.kernel,
+                    self.gradient,
+                    crate::integration_correction::points_per_axis(D),
+                )?
+                .into(),
+            )
+        };
         Ok(self)
     }
 

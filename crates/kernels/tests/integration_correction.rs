@@ -96,7 +96,7 @@ fn the_correction_is_the_derivatives_integral_defect_over_the_weight() {
 }
 
 /// The correction leaves the stencils alone (the conformance suite's reproduction holds
-/// for them as for the plain kernel), is zero for the full derivative, and is the same,
+/// for them as for the plain kernel), is none for the full derivative, and is the same,
 /// bit for bit, on any number of threads.
 #[test]
 fn the_correction_changes_no_stencil_and_no_bit_with_the_threads() {
