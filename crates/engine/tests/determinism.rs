@@ -268,7 +268,14 @@ fn stored_factored_and_recomputed_stencils_give_the_same_bits() {
     same("umls", Umls2::new(triangles.clone()), 0.0125);
     same(
         "umls full gradient (entries)",
-        Umls2::new(triangles).with_gradient(umls_mls::GradientKind::Full),
+        Umls2::new(triangles.clone()).with_gradient(umls_mls::GradientKind::Full),
+        0.0125,
+    );
+    // ξ̄_p of the integration correction: stored with the entries, or summed by P2G over
+    // the same evaluation as the entries (factored and recomputed stencils).
+    same(
+        "umls with the integration correction",
+        Umls2::new(triangles).with_integration_correction().unwrap(),
         0.0125,
     );
     let tets = Lattice::new([0.0; 3], [1.0; 3], [6; 3]).jitter(0.2, 3);

@@ -202,7 +202,8 @@ impl<const D: usize, const N: usize, B, W: WeightFunction> UmlsMeshKernel<D, N, 
         self
     }
 
-    /// The same kernel with the force's gradients corrected to ∇N_i + N_i ξ_i, with ξ_i
+    /// The same kernel with the force's gradients corrected to ∇N_i + N_i (ξ_i − ξ̄_p)
+    /// ([`Kernel::force_gradient_correction`] hands the engine ξ), with ξ_i
     /// fitted over the mesh so that every vertex's corrected gradient integrates like the
     /// derivative of N_i (integration correction; the velocity gradient keeps the
     /// stencils' own). Costs one fit at 3^D points of every simplex (2^D in 3D) and a few
@@ -226,11 +227,6 @@ impl<const D: usize, const N: usize, B, W: WeightFunction> UmlsMeshKernel<D, N, 
             )
         };
         Ok(self)
-    }
-
-    /// The force's integration correction ξ_i per vertex, if the kernel has one.
-    pub fn integration_correction(&self) -> Option<&[SVector<f64, D>]> {
-        self.correction.as_deref()
     }
 
     /// Which gradient the stencils carry.

@@ -273,10 +273,12 @@ pub trait Kernel<const D: usize>: Send + Sync {
     }
 
     /// Per-node vectors ξ_i with which the internal force's shape-function gradients
-    /// become ∇N_i + N_i ξ_i (an integration correction the kernel computed over its
-    /// domain, for a gradient that is not the derivative of N_i, such as an MLS fit's
-    /// reconstructed gradient), indexed by node; `None` (the default) for none. The
-    /// velocity gradient keeps ∇N_i, which reproduces affine fields.
+    /// become ∇N_i + N_i (ξ_i − ξ̄_p), ξ̄_p = Σ_j N_j(x_p) ξ_j (an integration correction
+    /// the kernel computed over its domain, for a gradient that is not the derivative of
+    /// N_i, such as an MLS fit's reconstructed gradient; subtracting ξ̄_p keeps the
+    /// corrections summing to zero over a stencil, so momentum is conserved), indexed by
+    /// node; `None` (the default) for none. The velocity gradient keeps ∇N_i, which
+    /// reproduces affine fields.
     fn force_gradient_correction(&self) -> Option<&[SVector<f64, D>]> {
         None
     }

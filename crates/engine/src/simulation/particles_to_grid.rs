@@ -138,42 +138,46 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         correction_mean: SVector::zeros(),
                         transfer: std::marker::PhantomData::<T>,
                     };
-                    if let Some(xi) = correction {
-                        sink.correction_mean = match stencils.stored_correction_mean(i) {
-                            Some(mean) => *mean,
-                            None => {
-                                stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
-                                    correction_mean(&st, xi)
-                                })?
-                            }
-                        };
-                    }
                     let stored_moment = stencils.stored_second_moment(i);
-                    if T::AFFINE && varying_moment && stored_moment.is_none() {
-                        // The limiter reads the whole stencil before the first entry.
+                    // The limiter and the correction's ξ̄_p read the whole stencil before
+                    // the first entry, unless the stencil stage stored what they need.
+                    let limiter_reads = T::AFFINE && varying_moment && stored_moment.is_none();
+                    let stored_mean = correction.and(stencils.stored_correction_mean(i));
+                    let mean_reads = correction.is_some() && stored_mean.is_none();
+                    if let Some(mean) = stored_mean {
+                        sink.correction_mean = *mean;
+                    }
+                    if T::FUSED_FORCE {
+                        // MLS-MPM: ∇N_i ≈ D⁻¹ N_i r_i folds the stress impulse into the
+                        // affine term, and gravity into the momentum.
+                        let inverse_moment = 1.0 / constant_moment;
+                        sink.affine = p.affine[i] * m - stress_volume * (dt * inverse_moment);
+                        sink.velocity = (v + acceleration * dt) * m;
+                    } else if let Some(d) = stored_moment.filter(|_| T::AFFINE) {
+                        // D_p summed with the stencil ([`Stencils::compute`]): the entries
+                        // are visited once.
+                        sink.affine = limited_affine(&p.affine[i], p.affine_moment[i], || *d);
+                    } else if T::AFFINE && !limiter_reads {
+                        sink.affine = p.affine[i];
+                    }
+                    if limiter_reads || mean_reads {
+                        // One evaluation serves the whole-stencil sums and the entries.
                         stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
-                            sink.affine = limited_affine(&p.affine[i], p.affine_moment[i], || {
-                                second_moment(&st, kernel, &x)
-                            });
+                            if let Some(xi) = correction.filter(|_| mean_reads) {
+                                sink.correction_mean = correction_mean(&st, xi);
+                            }
+                            if limiter_reads {
+                                sink.affine =
+                                    limited_affine(&p.affine[i], p.affine_moment[i], || {
+                                        second_moment(&st, kernel, &x)
+                                    });
+                            }
                             for e in 0..st.len() {
                                 let r = st.offset(e, kernel, &x);
                                 sink.entry(st.nodes[e], st.values[e], &st.gradients[e], &r);
                             }
                         })?;
                     } else {
-                        if T::FUSED_FORCE {
-                            // MLS-MPM: ∇N_i ≈ D⁻¹ N_i r_i folds the stress impulse into
-                            // the affine term, and gravity into the momentum.
-                            let inverse_moment = 1.0 / constant_moment;
-                            sink.affine = p.affine[i] * m - stress_volume * (dt * inverse_moment);
-                            sink.velocity = (v + acceleration * dt) * m;
-                        } else if let Some(d) = stored_moment.filter(|_| T::AFFINE) {
-                            // D_p summed with the stencil ([`Stencils::compute`]): the
-                            // entries are visited once.
-                            sink.affine = limited_affine(&p.affine[i], p.affine_moment[i], || *d);
-                        } else if T::AFFINE {
-                            sink.affine = p.affine[i];
-                        }
                         stencils.visit(
                             i,
                             kernel,
