@@ -10,27 +10,35 @@ use crate::scene::Scene;
 use crate::setup::Setup;
 
 /// RMS over particles of |v − v_ref(X, t)|, divided by the reference's scale; `None`
-/// without a velocity reference.
+/// without a velocity reference. `time` is when the last step ended and `step_dt` its
+/// length (0 before the first step); with `velocity_time = "mid-step"` the reference is
+/// taken at `time − step_dt / 2`.
 pub fn velocity_error<const D: usize>(
     scene: &Scene,
     setup: &Setup<D>,
     initial: &[SVector<f64, D>],
     velocities: &[SVector<f64, D>],
     time: f64,
+    step_dt: f64,
 ) -> Result<Option<f64>> {
-    let Some((field, scale)) = &setup.reference else {
+    let Some(reference) = &setup.reference else {
         return Ok(None);
+    };
+    let time = if reference.mid_step {
+        time - 0.5 * step_dt
+    } else {
+        time
     };
     let rms = rms_error(
         scene,
         "reference.velocity",
         setup,
-        field,
+        &reference.field,
         initial,
         time,
         |i| velocities[i],
     )?;
-    Ok(Some(rms / scale))
+    Ok(Some(rms / reference.scale))
 }
 
 /// RMS over particles of |x − X − u_ref(X, t)| (a length: the displacement has no

@@ -801,6 +801,11 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
             &reference_positions,
             sim.velocities(),
             sim.time(),
+            if sim.step_count() > 0 {
+                sim.last_dt()
+            } else {
+                0.0
+            },
         )
     };
 

@@ -794,6 +794,9 @@ pub struct ReferenceSpec {
     pub velocity: Option<Vec<Component>>,
     /// Velocity scale the RMSE is divided by (default: the largest |v(X, 0)|).
     pub scale: Option<f64>,
+    /// When after a step `velocity` is evaluated (default: at the step's end).
+    #[serde(default)]
+    pub velocity_time: VelocityTimeSpec,
     /// The column's exact stress at the end of the run.
     pub hydrostatic: Option<HydrostaticSpec>,
     /// D expressions in x, y, z (initial position) and t: the exact displacement.
@@ -802,6 +805,20 @@ pub struct ReferenceSpec {
     pub probe: Option<ProbeReferenceSpec>,
     /// The pressure on a closed wall, from its reaction forces.
     pub pressure: Option<PressureSpec>,
+}
+
+/// `reference.velocity_time`: the time a step's particle velocities are compared at.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum VelocityTimeSpec {
+    /// t_{n+1}, the time the step ends at.
+    #[default]
+    End,
+    /// t_{n+1} − Δt/2. The step is symplectic Euler: the velocities it gives are the
+    /// leapfrog's half-step velocities, a second-order approximation of v at the step's
+    /// midpoint and only a first-order one at its end. Second order from the start when
+    /// the initial acceleration vanishes (a body starting undeformed, at rest or moving).
+    MidStep,
 }
 
 /// `[reference.pressure]`.

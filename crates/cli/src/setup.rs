@@ -22,7 +22,7 @@ use crate::probes::ProbeReference;
 use crate::scene::Scene;
 use crate::schema::{
     BoundaryKind, DiagonalSpec, Imposed, MaterialSpec, QuadratureSpec, RegionSpec, SeedingSpec,
-    SolidSpec, StressUpdateSpec,
+    SolidSpec, StressUpdateSpec, VelocityTimeSpec,
 };
 use umls_constitutive::table::{ElasticModel, Model, PlasticModel};
 
@@ -100,8 +100,9 @@ pub struct Setup<const D: usize> {
     pub geostatic_k0: Option<f64>,
     /// What the user should hear about the setup (a body clipped by the mesh, …).
     pub warnings: Vec<String>,
-    /// The analytic velocity v(X, t) (scene frame), and the scale its RMSE is divided by.
-    pub reference: Option<(VectorField<D>, f64)>,
+    /// The analytic velocity v(X, t) (scene frame), the scale its RMSE is divided by,
+    /// and whether it is compared half a step before a step's end.
+    pub reference: Option<VelocityReference<D>>,
     /// The hydrostatic column's closed form (scene frame).
     pub hydrostatic: Option<Hydrostatic<D>>,
     /// The exact displacement u(X, t) (scene frame).
@@ -115,6 +116,17 @@ pub struct Setup<const D: usize> {
     /// The rotation from the scene as written into the world it runs in; everything
     /// above except the references is already in the world frame.
     pub frame: SceneFrame<D>,
+}
+
+/// `[reference] velocity`, compiled.
+#[derive(Debug, Clone)]
+pub struct VelocityReference<const D: usize> {
+    /// v(X, t) in the scene frame.
+    pub field: VectorField<D>,
+    /// The scale the RMSE is divided by.
+    pub scale: f64,
+    /// Compare at t_{n+1} − Δt/2 (`velocity_time = "mid-step"`) instead of t_{n+1}.
+    pub mid_step: bool,
 }
 
 impl<const D: usize> Setup<D> {
@@ -826,9 +838,27 @@ pub fn build_for<const D: usize>(
                     largest
                 }
             };
-            Some((field, scale))
+            let mid_step = spec
+                .reference
+                .as_ref()
+                .is_some_and(|r| r.velocity_time == VelocityTimeSpec::MidStep);
+            Some(VelocityReference {
+                field,
+                scale,
+                mid_step,
+            })
         }
     };
+    if spec
+        .reference
+        .as_ref()
+        .is_some_and(|r| r.velocity.is_none() && r.velocity_time != VelocityTimeSpec::End)
+    {
+        return Err(scene.value_error(
+            "reference.velocity_time",
+            "times `reference.velocity`, which is not given",
+        ));
+    }
     let hydrostatic = match spec.reference.as_ref() {
         Some(r)
             if r.velocity.is_none()

@@ -374,6 +374,19 @@ fn bad_values_name_their_key() {
             "`reference.scale`",
         ),
         (
+            "vibrating-bar",
+            "velocity_time = \"mid-step\"",
+            "velocity_time = \"midstep\"",
+            "unknown variant `midstep`, expected `end` or `mid-step`",
+        ),
+        // The time a velocity is compared at needs the velocity.
+        (
+            "vibrating-bar",
+            "velocity = [\"0.1 * cos(PI * t / 5) * sin(PI * x / 50)\"]\nscale = 0.1",
+            "displacement = [\"0\"]",
+            "`reference.velocity_time`",
+        ),
+        (
             "steel-cantilever",
             "group = \"wall\"",
             "group = \"floor\"",
