@@ -37,11 +37,7 @@ fn orders(results: &[BarError]) -> Vec<f64> {
 fn umls_converges_at_second_order() {
     let results: Vec<BarError> = [16usize, 32, 64, 128]
         .iter()
-        .map(|&cells| {
-            let bar = level(cells);
-            bar.run(Umls1::new(Arc::new(bar.mesh().unwrap())), Apic)
-                .unwrap()
-        })
+        .map(|&cells| umls_bar(&level(cells)))
         .collect();
     let orders = orders(&results);
     eprintln!("UMLS + APIC: {results:?}, orders {orders:?}");
@@ -78,11 +74,23 @@ fn bspline_bar(cells: usize, order: BSplineOrder) -> BarError {
 /// [`bspline_bar`] with a mass matrix.
 fn bspline_bar_with(cells: usize, order: BSplineOrder, mass_matrix: MassMatrix) -> BarError {
     let bar = level(cells);
+    bar.run_with(bspline_grid(&bar, order), Apic, |s| {
+        s.mass_matrix = mass_matrix
+    })
+    .unwrap()
+}
+
+/// The bar with UMLS and APIC on its own mesh.
+fn umls_bar(bar: &VibratingBar) -> BarError {
+    bar.run(Umls1::new(Arc::new(bar.mesh().unwrap())), Apic)
+        .unwrap()
+}
+
+/// A B-spline grid of the bar's cell size covering its mirrored mesh.
+fn bspline_grid(bar: &VibratingBar, order: BSplineOrder) -> BSplineKernel<1> {
     let dx = bar.dx();
     let half = bar.length + 4.0 * dx;
-    let grid = BSplineKernel::new(SVector::from([-half]), dx, [2 * (cells + 4)], order).unwrap();
-    bar.run_with(grid, Apic, |s| s.mass_matrix = mass_matrix)
-        .unwrap()
+    BSplineKernel::new(SVector::from([-half]), dx, [2 * (bar.cells + 4)], order).unwrap()
 }
 
 /// With the consistent mass matrix (two iterations, forces included) for both kernels,
@@ -119,6 +127,71 @@ fn consistent_mass_puts_umls_at_or_below_bspline2() {
             "{c} cells: UMLS {u:?} against bspline2 {spline:?}"
         );
     }
+}
+
+/// With two particles per cell UMLS is at or below bspline2 at 32, 64 and 128 cells, and
+/// converges at second order or better (measured: UMLS 1.381·10⁻² / 1.263·10⁻³ /
+/// 1.795·10⁻⁴ / 3.822·10⁻⁵, bspline2 1.318·10⁻² / 1.264·10⁻³ / 1.985·10⁻⁴ /
+/// 4.450·10⁻⁵ at 16 / 32 / 64 / 128 cells). With one particle per cell bspline2 keeps
+/// the lead (`one_particle_at_cell_centres_makes_bspline2_apic_lossless`).
+#[test]
+fn two_particles_per_cell_put_umls_at_or_below_bspline2() {
+    let cells = [16usize, 32, 64, 128];
+    let two = |cells: usize| VibratingBar {
+        particles_per_cell: 2,
+        ..level(cells)
+    };
+    let umls: Vec<BarError> = cells.iter().map(|&c| umls_bar(&two(c))).collect();
+    let orders = orders(&umls);
+    eprintln!("UMLS + APIC, 2 per cell: {umls:?}, orders {orders:?}");
+    assert!(orders.iter().all(|&p| p >= 1.9), "orders {orders:?}");
+    for (&c, u) in cells.iter().zip(&umls).skip(1) {
+        let bar = two(c);
+        let spline = bar
+            .run(bspline_grid(&bar, BSplineOrder::Quadratic), Apic)
+            .unwrap();
+        eprintln!(
+            "{c} cells: UMLS {:.4e}, bspline2 {:.4e}",
+            u.velocity_rmse, spline.velocity_rmse
+        );
+        assert!(
+            u.velocity_rmse <= spline.velocity_rmse,
+            "{c} cells: UMLS {u:?} against bspline2 {spline:?}"
+        );
+    }
+}
+
+/// Why bspline2 leads with one particle per cell: a particle at a cell's centre has
+/// N = 1/2 at the cell's two nodes and 0 beyond, D_p = h²/4, so APIC's grid → particle →
+/// grid round trip is the identity (the diagonal Σ_p N_ip² (1 + r_ip²/D_p) / m_i is 1,
+/// the neighbours' Σ_p N_ip N_jp (1 + r_ip r_jp / D_p) is 0): the bar's mode loses
+/// nothing per step, and eight times as many steps change nothing. UMLS's round trip
+/// filters the mode a little on every step, so the same refinement of Δt multiplies its
+/// error (measured at 16 cells: bspline2 1.490·10⁻³ → 1.485·10⁻³, UMLS 4.85·10⁻³ →
+/// 2.59·10⁻²).
+#[test]
+fn one_particle_at_cell_centres_makes_bspline2_apic_lossless() {
+    let smaller_dt = |bar: VibratingBar| VibratingBar {
+        courant: bar.courant / 8.0,
+        ..bar
+    };
+    let bar = level(16);
+    let spline = bspline_bar(16, BSplineOrder::Quadratic);
+    let fine = smaller_dt(bar);
+    let spline_fine = fine
+        .run(bspline_grid(&fine, BSplineOrder::Quadratic), Apic)
+        .unwrap();
+    let umls = umls_bar(&bar);
+    let umls_fine = umls_bar(&fine);
+    eprintln!("bspline2 {spline:?} -> {spline_fine:?}; UMLS {umls:?} -> {umls_fine:?}");
+    assert!(
+        (spline_fine.velocity_rmse / spline.velocity_rmse - 1.0).abs() < 0.02,
+        "bspline2 {spline:?} -> {spline_fine:?}"
+    );
+    assert!(
+        umls_fine.velocity_rmse > 3.0 * umls.velocity_rmse,
+        "UMLS {umls:?} -> {umls_fine:?}"
+    );
 }
 
 #[test]
@@ -239,19 +312,10 @@ fn bar_at_104_cells_with_apic_runs_with_every_kernel() {
     let fe = bar
         .run(LinearFeKernel::new(Arc::new(bar.mesh().unwrap())), Apic)
         .unwrap();
-    let umls = bar
-        .run(Umls1::new(Arc::new(bar.mesh().unwrap())), Apic)
+    let umls = umls_bar(&bar);
+    let spline = bar
+        .run(bspline_grid(&bar, BSplineOrder::Quadratic), Apic)
         .unwrap();
-    let dx = bar.dx();
-    let half = bar.length + 4.0 * dx;
-    let grid = BSplineKernel::new(
-        SVector::from([-half]),
-        dx,
-        [2 * (104 + 4)],
-        BSplineOrder::Quadratic,
-    )
-    .unwrap();
-    let spline = bar.run(grid, Apic).unwrap();
     // Measured: linear FE 3.8·10⁻⁵, UMLS 4.0·10⁻⁵, bspline2 3.6·10⁻⁵.
     for (name, e) in [("linear FE", fe), ("UMLS", umls), ("bspline2", spline)] {
         eprintln!("{name}: {e:?}");
