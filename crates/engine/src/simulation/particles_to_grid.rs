@@ -36,8 +36,10 @@ fn limited_affine<const D: usize>(
     }
 }
 
-/// One particle's contributions to the nodes of its stencil.
-struct ScatterEntry<'w, const D: usize, T> {
+/// One particle's contributions to the nodes of its stencil. `CORRECTED` is whether the
+/// kernel has an integration correction: a constant, so that the kernels without one
+/// (B-splines, whose visits are inlined here) keep an entry free of its branch.
+struct ScatterEntry<'w, const D: usize, T, const CORRECTED: bool> {
     window: &'w mut Window<D>,
     /// The affine matrix P2G spreads (zero without an affine transfer).
     affine: SMatrix<f64, D, D>,
@@ -47,16 +49,18 @@ struct ScatterEntry<'w, const D: usize, T> {
     /// Kirchhoff stress times the current volume.
     stress_volume: SMatrix<f64, D, D>,
     acceleration: SVector<f64, D>,
-    /// The kernel's integration correction ξ_i per node, if it has one: the force's
-    /// gradient is ∇N_i + N_i (ξ_i − ξ̄_p) ([`Kernel::force_gradient_correction`]).
-    correction: Option<&'w [SVector<f64, D>]>,
+    /// The kernel's integration correction ξ_i per node (empty unless `CORRECTED`): the
+    /// force's gradient is ∇N_i + N_i (ξ_i − ξ̄_p) ([`Kernel::force_gradient_correction`]).
+    correction: &'w [SVector<f64, D>],
     /// ξ̄_p = Σ_i N_i ξ_i at the particle, which makes the corrections sum to zero over
     /// its stencil, so the internal forces still sum to zero (momentum is conserved).
     correction_mean: SVector<f64, D>,
     transfer: std::marker::PhantomData<T>,
 }
 
-impl<const D: usize, T: TransferScheme> EntrySink<D> for ScatterEntry<'_, D, T> {
+impl<const D: usize, T: TransferScheme, const CORRECTED: bool> EntrySink<D>
+    for ScatterEntry<'_, D, T, CORRECTED>
+{
     #[inline(always)]
     fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, r: &SVector<f64, D>) {
         let m = self.mass;
@@ -72,12 +76,11 @@ impl<const D: usize, T: TransferScheme> EntrySink<D> for ScatterEntry<'_, D, T> 
             mv += self.affine * r;
         }
         let corrected;
-        let gradient = match self.correction {
-            Some(xi) => {
-                corrected = gradient + (xi[node as usize] - self.correction_mean) * n;
-                &corrected
-            }
-            None => gradient,
+        let gradient = if CORRECTED {
+            corrected = gradient + (self.correction[node as usize] - self.correction_mean) * n;
+            &corrected
+        } else {
+            gradient
         };
         self.window.add(
             node as usize,
@@ -93,6 +96,15 @@ impl<const D: usize, T: TransferScheme> EntrySink<D> for ScatterEntry<'_, D, T> 
 impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
     /// P2G into the grid's mass, |N|-mass, stiffness, momentum and force.
     pub(super) fn particles_to_grid(&mut self) -> Result<(), EngineError> {
+        match self.kernel.force_gradient_correction() {
+            Some(_) => self.scatter_particles::<true>(),
+            None => self.scatter_particles::<false>(),
+        }
+    }
+
+    /// [`Self::particles_to_grid`] for a kernel with (`CORRECTED`) or without an
+    /// integration correction.
+    fn scatter_particles<const CORRECTED: bool>(&mut self) -> Result<(), EngineError> {
         let stresses = &self.stress_buffer;
         let p = &self.particles;
         let (stencils, kernel, time, step) = (&self.stencils, &self.kernel, self.time, self.step);
@@ -115,7 +127,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let constant_moment = kernel.constant_second_moment().unwrap_or(f64::NAN);
         let dt = self.dt;
         let ranges = stencils.ranges();
-        let correction = kernel.force_gradient_correction();
+        let correction = kernel.force_gradient_correction().filter(|_| CORRECTED);
         self.scatter
             .scatter(ranges, sums, |block, window| {
                 let mut scratch = Stencil::new();
@@ -126,7 +138,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     let stress_volume = stresses[i] * volume;
                     let acceleration =
                         gravity + body_force.map_or(SVector::zeros(), |b| b(&x, time));
-                    let mut sink = ScatterEntry {
+                    let mut sink = ScatterEntry::<D, T, CORRECTED> {
                         window,
                         affine: SMatrix::zeros(),
                         mass: m,
@@ -134,7 +146,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         volume,
                         stress_volume,
                         acceleration,
-                        correction,
+                        correction: correction.unwrap_or(&[]),
                         correction_mean: SVector::zeros(),
                         transfer: std::marker::PhantomData::<T>,
                     };
