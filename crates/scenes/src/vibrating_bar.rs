@@ -190,7 +190,7 @@ impl VibratingBar {
             // starts undeformed, so its initial acceleration is zero and the start adds
             // no first-order offset), only first-order at its end. Compared at the end,
             // the time error ω Δt / 2 was the floor every kernel met from 64 cells on.
-            let t = sim.time() - 0.5 * dt;
+            let t = sim.time() - 0.5 * sim.last_dt();
             for (v, x) in sim.particles().velocity.iter().zip(&reference) {
                 sq += (v[0] - self.velocity(*x, t)).powi(2);
                 count += 1.0;
