@@ -371,17 +371,27 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
     ) -> Result<f64, MlsError> {
         let inv_scale = crate::solve::inverse_scale(self.scale(mesh, host))?;
         let ring = mesh.topology().one_ring(host as usize);
-        for (((&v, &mask), weight), xi) in ring
+        // Two passes: the loads of the ring's vertices and radii (scattered over the
+        // mesh) first, then the arithmetic over the slices alone, which overlaps the
+        // square roots and divisions of neighbouring vertices. The same operations as
+        // `radial_weight` (|x_v − x| = |x − x_v| bit for bit), so the same bits.
+        for ((&v, radius), offset) in ring
             .vertices
             .iter()
-            .zip(ring.masks)
             .zip(weights.iter_mut())
             .zip(scaled_offsets.iter_mut())
         {
-            let xv = mesh.vertex(v as usize);
-            let (d, _) = radial_weight(&self.weight, x, xv, self.radii[v as usize]);
+            *offset = mesh.vertex(v as usize) - x;
+            *radius = self.radii[v as usize];
+        }
+        for ((weight, xi), &mask) in weights
+            .iter_mut()
+            .zip(scaled_offsets.iter_mut())
+            .zip(ring.masks)
+        {
+            let (d, _) = self.weight.evaluate(xi.norm() / *weight);
             *weight = diminishing_factor(mask, lambda.as_slice()) * d;
-            *xi = (xv - x) * inv_scale;
+            *xi *= inv_scale;
         }
         Ok(inv_scale)
     }
