@@ -23,8 +23,10 @@
 
 use nalgebra::SVector;
 use umls_mesh::{Barycentric, Located, SimplexMesh};
-use umls_mls::{GradientKind, PolynomialBasis, UmlsKernel, WeightFunction};
+use umls_mls::{PolynomialBasis, WeightFunction};
 use umls_transfer::{KernelError, Stencil};
+
+use crate::UmlsMeshKernel;
 
 /// Gauss–Jacobi points per axis of the conical-product rules in `dim` dimensions: 3 on
 /// segments and triangles (9 points per triangle, exact for quintics), 2 on tetrahedra
@@ -135,15 +137,13 @@ impl<const D: usize> NodeIntegrals<D> {
     };
 }
 
-/// ξ_i for every vertex of `mesh` with the fit `kernel` whose stencils carry `gradient`
-/// (reconstructed or frozen-η; the full derivative needs none: all zero), integrated
-/// with `points_per_axis` Gauss points per axis in every simplex. A vertex whose ∫N_i
+/// ξ_i for every vertex of `kernel`'s mesh with its fit and gradient (reconstructed or
+/// frozen-η; [`UmlsMeshKernel::with_integration_correction`] asks for none with the full
+/// derivative), integrated with `points_per_axis` Gauss points per axis in every simplex. A vertex whose ∫N_i
 /// has cancelled (negative MLS values) to below 10⁻³ of ∫|N_i| gets none. Blocks of
 /// simplices are integrated in parallel and merged in block order.
 pub(crate) fn node_corrections<const D: usize, const N: usize, B, W>(
-    mesh: &SimplexMesh<D>,
-    kernel: &UmlsKernel<D, W>,
-    gradient: GradientKind,
+    kernel: &UmlsMeshKernel<D, N, B, W>,
     points_per_axis: usize,
 ) -> Result<Vec<SVector<f64, D>>, KernelError>
 where
@@ -151,10 +151,8 @@ where
     W: WeightFunction,
 {
     use rayon::prelude::*;
+    let mesh: &SimplexMesh<D> = kernel.mesh();
     let nodes = mesh.vertex_count();
-    if gradient == GradientKind::Full {
-        return Ok(vec![SVector::zeros(); nodes]);
-    }
     let volume_rule: Vec<(Barycentric<D>, f64)> = simplex_rule(D, points_per_axis)
         .into_iter()
         .filter_map(|(l, w)| Some((Barycentric::<D>::from_slice(&l[..=D])?, w)))
@@ -166,20 +164,7 @@ where
             simplex: simplex as u32,
             barycentric: *lambda,
         };
-        let x = mesh.point_at(simplex, lambda);
-        let ring = mesh.topology().one_ring(simplex).len();
-        let entries = out.entries_mut(ring);
-        kernel
-            .evaluate_into::<N, B>(
-                mesh,
-                &located,
-                &x,
-                gradient,
-                entries.nodes,
-                entries.values,
-                entries.gradients,
-            )
-            .map_err(|e| KernelError::evaluation("UMLS", e))
+        kernel.fit_into(&located, &mesh.point_at(simplex, lambda), out)
     };
     // Each block's integrals per vertex it reaches, in ascending vertex order.
     // Work items: blocks of simplices, then blocks of boundary facets.

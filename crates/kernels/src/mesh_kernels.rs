@@ -217,10 +217,8 @@ impl<const D: usize, const N: usize, B, W: WeightFunction> UmlsMeshKernel<D, N, 
             None
         } else {
             Some(
-                crate::integration_correction::node_corrections::<D, N, B, W>(
-                    &self.mesh,
-                    &self.kernel,
-                    self.gradient,
+                crate::integration_correction::node_corrections(
+                    &self,
                     crate::integration_correction::points_per_axis(D),
                 )?
                 .into(),
@@ -243,6 +241,42 @@ impl<const D: usize, const N: usize, B, W: WeightFunction> UmlsMeshKernel<D, N, 
     pub fn kernel(&self) -> &UmlsKernel<D, W> {
         &self.kernel
     }
+
+    /// The fit at `x`, located with its barycentric coordinates in `located`, written
+    /// into `out`'s nodes, values and gradients (offsets left as they are); `out` is
+    /// cleared when the fit fails. The stencils and the integration correction's
+    /// quadrature both evaluate the kernel through it.
+    pub(crate) fn fit_into(
+        &self,
+        located: &Located<D>,
+        x: &SVector<f64, D>,
+        out: &mut Stencil<D>,
+    ) -> Result<(), KernelError>
+    where
+        B: PolynomialBasis<D, N>,
+    {
+        // Written in place: no fixed-capacity stencil between the fit and `out`.
+        let ring = self
+            .mesh
+            .topology()
+            .one_ring(located.simplex as usize)
+            .len();
+        let entries = out.entries_mut(ring);
+        let evaluated = self.kernel.evaluate_into::<N, B>(
+            &self.mesh,
+            located,
+            x,
+            self.gradient,
+            entries.nodes,
+            entries.values,
+            entries.gradients,
+        );
+        if let Err(e) = evaluated {
+            out.clear();
+            return Err(KernelError::evaluation("UMLS", e));
+        }
+        Ok(())
+    }
 }
 
 impl<const D: usize, const N: usize, B, W> Kernel<D> for UmlsMeshKernel<D, N, B, W>
@@ -261,26 +295,8 @@ where
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError> {
         let located = locate_with_coordinates(&self.mesh, x, cache)?;
-        // Written in place: no fixed-capacity stencil between the fit and `out`.
-        let ring = self
-            .mesh
-            .topology()
-            .one_ring(located.simplex as usize)
-            .len();
-        let entries = out.entries_mut(ring);
-        let evaluated = self.kernel.evaluate_into::<N, B>(
-            &self.mesh,
-            &located,
-            x,
-            self.gradient,
-            entries.nodes,
-            entries.values,
-            entries.gradients,
-        );
-        if let Err(e) = evaluated {
-            out.clear();
-            return Err(KernelError::evaluation("UMLS", e));
-        }
+        self.fit_into(&located, x, out)?;
+        let entries = out.entries_mut(out.len());
         for (offset, &v) in entries.offsets.iter_mut().zip(entries.nodes.iter()) {
             *offset = self.mesh.vertex(v as usize) - x;
         }
