@@ -7,20 +7,27 @@
 //!   every crate (skipped by `--quick`, whose matrix has coarse levels only, and by
 //!   `--no-criterion`, which reports the criterion results already there); `--docs`
 //!   copies the report to `docs/report/`.
+//! - `compare REV [--rounds N] [--threads N] [--case ARGS]... [--fail-above R]`: the
+//!   working tree's speed against revision `REV` on the same machine, alternating short
+//!   runs of both builds, with stage times, ratios and whether the results stayed bit
+//!   for bit the same (`compare.rs`; report in `target/compare/compare.md`).
 //! - `deny`: `cargo deny check` (needs `cargo install cargo-deny`).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
+
+mod compare;
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
         Some("ci") => ci(),
         Some("bench") => bench(&args[1..]),
+        Some("compare") => compare::compare(&args[1..]),
         Some("deny") => cargo(&["deny", "check"]),
         _ => {
             eprintln!(
-                "usage: cargo xtask <ci | bench [--quick] [--no-criterion] [--save-baseline NAME | --baseline NAME] [--docs] | deny>"
+                "usage: cargo xtask <ci | bench [--quick] [--no-criterion] [--save-baseline NAME | --baseline NAME] [--docs] | compare REV [--rounds N] [--threads N] [--case ARGS]... [--fail-above R] | deny>"
             );
             return ExitCode::from(2);
         }
