@@ -44,8 +44,12 @@ use crate::settings::Damping;
 pub(crate) struct Grid<const D: usize> {
     /// m_i = Σ N m_p.
     pub mass: Vec<f64>,
-    /// Σ |N| m_p.
+    /// Σ |N| m_p, unless [`Self::abs_mass_is_mass`] (read it through
+    /// [`Self::abs_mass`]).
     pub abs_mass: Vec<f64>,
+    /// Whether P2G left `abs_mass` alone because every N ≥ 0 made it the mass
+    /// (`Kernel::nonnegative_values`).
+    pub abs_mass_is_mass: bool,
     /// p_i = Σ N m_p (v_p + C_p (x_i − x_p)).
     pub momentum: Vec<SVector<f64, D>>,
     /// f_i: internal plus external force.
@@ -158,6 +162,7 @@ impl<const D: usize> Grid<D> {
             round_off_mass: 1e-12 * heaviest_particle,
             mass: vec![0.0; nodes],
             abs_mass: vec![0.0; nodes],
+            abs_mass_is_mass: false,
             momentum: vec![SVector::zeros(); nodes],
             force: vec![SVector::zeros(); nodes],
             stiffness: vec![0.0; nodes],
@@ -167,12 +172,21 @@ impl<const D: usize> Grid<D> {
         }
     }
 
+    /// Σ |N| m_p per node.
+    pub fn abs_mass(&self) -> &[f64] {
+        if self.abs_mass_is_mass {
+            &self.mass
+        } else {
+            &self.abs_mass
+        }
+    }
+
     /// Whether node `i` carries a velocity (see the module docs).
     #[inline]
     pub fn is_active(&self, i: usize, cancellation_fraction: f64) -> bool {
         active_node(
             self.mass[i],
-            self.abs_mass[i],
+            self.abs_mass()[i],
             self.round_off_mass,
             cancellation_fraction,
         )
@@ -235,10 +249,15 @@ impl<const D: usize> Grid<D> {
         // chunk order, so the report does not depend on the thread count.
         let round_off = self.round_off_mass;
         let local_damping = matches!(damping, Damping::Local { .. });
+        let abs_mass = if self.abs_mass_is_mass {
+            &self.mass
+        } else {
+            &self.abs_mass
+        };
         let partials: Vec<(f64, SVector<f64, D>, usize, f64)> = self
             .mass
             .par_chunks(NODE_CHUNK)
-            .zip(self.abs_mass.par_chunks(NODE_CHUNK))
+            .zip(abs_mass.par_chunks(NODE_CHUNK))
             .zip(self.momentum.par_chunks(NODE_CHUNK))
             .zip(self.force.par_chunks(NODE_CHUNK))
             .zip(self.stiffness.par_chunks(NODE_CHUNK))
@@ -301,7 +320,7 @@ impl<const D: usize> Grid<D> {
         // stays conserved to round-off, and the amount is reported.
         if active_mass > 0.0 && report.redistributed_momentum.norm_squared() > 0.0 {
             let shift = report.redistributed_momentum / active_mass;
-            let (mass, abs_mass) = (&self.mass, &self.abs_mass);
+            let mass = &self.mass;
             self.new_velocity
                 .par_iter_mut()
                 .enumerate()

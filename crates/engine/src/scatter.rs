@@ -26,64 +26,189 @@ pub(crate) const BLOCK: usize = 4096;
 const MAX_SPAN: usize = 4;
 
 /// One node's sums in a window, kept together so that a stencil entry's contribution
-/// touches one place in memory rather than five arrays.
+/// touches one place in memory rather than five arrays. `A` is 1 where Σ|N| m_p is
+/// summed apart from the mass, 0 for a kernel whose values are never negative (then it
+/// is the mass bit for bit, and a record is 64 bytes in 3D instead of 72).
 #[derive(Debug, Clone, Copy)]
-struct NodeSums<const D: usize> {
+struct NodeSums<const D: usize, const A: usize> {
     mass: f64,
-    abs_mass: f64,
+    abs_mass: [f64; A],
     stiffness: f64,
     momentum: SVector<f64, D>,
     force: SVector<f64, D>,
 }
 
-impl<const D: usize> NodeSums<D> {
+impl<const D: usize, const A: usize> NodeSums<D, A> {
     const ZERO: Self = Self {
         mass: 0.0,
-        abs_mass: 0.0,
+        abs_mass: [0.0; A],
         stiffness: 0.0,
         momentum: SVector::from_array_storage(nalgebra::ArrayStorage([[0.0; D]; 1])),
         force: SVector::from_array_storage(nalgebra::ArrayStorage([[0.0; D]; 1])),
     };
+
+    #[inline(always)]
+    fn add(
+        &mut self,
+        mass: f64,
+        abs_mass: f64,
+        stiffness: f64,
+        momentum: SVector<f64, D>,
+        force: SVector<f64, D>,
+    ) {
+        self.mass += mass;
+        for sum in &mut self.abs_mass {
+            *sum += abs_mass;
+        }
+        self.stiffness += stiffness;
+        self.momentum += momentum;
+        self.force += force;
+    }
 }
 
 /// One node's sums in a window of a momentum-only scatter (MLS-MPM): 40 bytes in 3D
-/// instead of 72, so the window's clearing, the entries and the merge move less memory.
+/// instead of 72, so the window's clearing, the entries and the merge move less memory;
+/// 32 without the |N|-mass (`A` = 0, as for [`NodeSums`]).
 #[derive(Debug, Clone, Copy)]
-struct MomentumSums<const D: usize> {
+struct MomentumSums<const D: usize, const A: usize> {
     mass: f64,
-    abs_mass: f64,
+    abs_mass: [f64; A],
     momentum: SVector<f64, D>,
 }
 
-impl<const D: usize> MomentumSums<D> {
+impl<const D: usize, const A: usize> MomentumSums<D, A> {
     const ZERO: Self = Self {
         mass: 0.0,
-        abs_mass: 0.0,
+        abs_mass: [0.0; A],
         momentum: SVector::from_array_storage(nalgebra::ArrayStorage([[0.0; D]; 1])),
     };
+
+    #[inline(always)]
+    fn add(&mut self, mass: f64, abs_mass: f64, momentum: SVector<f64, D>) {
+        self.mass += mass;
+        for sum in &mut self.abs_mass {
+            *sum += abs_mass;
+        }
+        self.momentum += momentum;
+    }
 }
 
-/// One block's share of the nodal sums, over nodes `lo..hi`: full records, or
-/// momentum-only ones (the other vector is then empty).
+/// A window record's share of the nodal sums, added into the chunk of nodes it falls in.
+trait Record<const D: usize>: Copy + Send + Sync {
+    /// The window's records of this kind.
+    fn records(window: &Window<D>) -> &[Self];
+    /// Zeroes the fields these records sum, over a chunk.
+    fn clear(chunk: &mut ChunkSums<'_, D>);
+    /// Adds the record to node `j` of the chunk.
+    fn add_into(&self, chunk: &mut ChunkSums<'_, D>, j: usize);
+}
+
+/// One chunk of [`NodalSums`]' arrays (those a layout does not sum are left alone).
+struct ChunkSums<'a, const D: usize> {
+    mass: &'a mut [f64],
+    abs_mass: &'a mut [f64],
+    stiffness: &'a mut [f64],
+    momentum: &'a mut [SVector<f64, D>],
+    force: &'a mut [SVector<f64, D>],
+}
+
+impl<const D: usize> Record<D> for NodeSums<D, 1> {
+    fn records(window: &Window<D>) -> &[Self] {
+        &window.sums
+    }
+    fn clear(chunk: &mut ChunkSums<'_, D>) {
+        NodeSums::<D, 0>::clear(chunk);
+        chunk.abs_mass.fill(0.0);
+    }
+    #[inline(always)]
+    fn add_into(&self, chunk: &mut ChunkSums<'_, D>, j: usize) {
+        chunk.mass[j] += self.mass;
+        chunk.abs_mass[j] += self.abs_mass[0];
+        chunk.stiffness[j] += self.stiffness;
+        chunk.momentum[j] += self.momentum;
+        chunk.force[j] += self.force;
+    }
+}
+
+impl<const D: usize> Record<D> for NodeSums<D, 0> {
+    fn records(window: &Window<D>) -> &[Self] {
+        &window.nonnegative_sums
+    }
+    fn clear(chunk: &mut ChunkSums<'_, D>) {
+        chunk.mass.fill(0.0);
+        chunk.stiffness.fill(0.0);
+        chunk.momentum.fill(SVector::zeros());
+        chunk.force.fill(SVector::zeros());
+    }
+    #[inline(always)]
+    fn add_into(&self, chunk: &mut ChunkSums<'_, D>, j: usize) {
+        chunk.mass[j] += self.mass;
+        chunk.stiffness[j] += self.stiffness;
+        chunk.momentum[j] += self.momentum;
+        chunk.force[j] += self.force;
+    }
+}
+
+impl<const D: usize> Record<D> for MomentumSums<D, 1> {
+    fn records(window: &Window<D>) -> &[Self] {
+        &window.momentum_sums
+    }
+    fn clear(chunk: &mut ChunkSums<'_, D>) {
+        MomentumSums::<D, 0>::clear(chunk);
+        chunk.abs_mass.fill(0.0);
+    }
+    #[inline(always)]
+    fn add_into(&self, chunk: &mut ChunkSums<'_, D>, j: usize) {
+        chunk.mass[j] += self.mass;
+        chunk.abs_mass[j] += self.abs_mass[0];
+        chunk.momentum[j] += self.momentum;
+    }
+}
+
+impl<const D: usize> Record<D> for MomentumSums<D, 0> {
+    fn records(window: &Window<D>) -> &[Self] {
+        &window.nonnegative_momentum_sums
+    }
+    fn clear(chunk: &mut ChunkSums<'_, D>) {
+        chunk.mass.fill(0.0);
+        chunk.momentum.fill(SVector::zeros());
+    }
+    #[inline(always)]
+    fn add_into(&self, chunk: &mut ChunkSums<'_, D>, j: usize) {
+        chunk.mass[j] += self.mass;
+        chunk.momentum[j] += self.momentum;
+    }
+}
+
+/// One block's share of the nodal sums, over nodes `lo..hi`, in the records of the
+/// scatter's layout ([`NodalSums::momentum_only`], [`NodalSums::nonnegative`]); the
+/// other vectors are empty.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Window<const D: usize> {
     lo: usize,
     hi: usize,
-    sums: Vec<NodeSums<D>>,
-    momentum_sums: Vec<MomentumSums<D>>,
+    sums: Vec<NodeSums<D, 1>>,
+    nonnegative_sums: Vec<NodeSums<D, 0>>,
+    momentum_sums: Vec<MomentumSums<D, 1>>,
+    nonnegative_momentum_sums: Vec<MomentumSums<D, 0>>,
 }
 
 impl<const D: usize> Window<D> {
-    fn reset(&mut self, lo: usize, hi: usize, momentum_only: bool) {
+    fn reset(&mut self, lo: usize, hi: usize, momentum_only: bool, nonnegative: bool) {
         let len = hi.saturating_sub(lo);
         self.lo = lo;
         self.hi = lo + len;
         self.sums.clear();
+        self.nonnegative_sums.clear();
         self.momentum_sums.clear();
-        if momentum_only {
-            self.momentum_sums.resize(len, MomentumSums::ZERO);
-        } else {
-            self.sums.resize(len, NodeSums::ZERO);
+        self.nonnegative_momentum_sums.clear();
+        match (momentum_only, nonnegative) {
+            (false, false) => self.sums.resize(len, NodeSums::ZERO),
+            (false, true) => self.nonnegative_sums.resize(len, NodeSums::ZERO),
+            (true, false) => self.momentum_sums.resize(len, MomentumSums::ZERO),
+            (true, true) => self
+                .nonnegative_momentum_sums
+                .resize(len, MomentumSums::ZERO),
         }
     }
 
@@ -91,10 +216,20 @@ impl<const D: usize> Window<D> {
         self.hi
     }
 
+    /// Bytes of the records.
+    fn bytes(&self) -> usize {
+        use crate::memory::bytes;
+        bytes(&self.sums)
+            + bytes(&self.nonnegative_sums)
+            + bytes(&self.momentum_sums)
+            + bytes(&self.nonnegative_momentum_sums)
+    }
+
     /// Adds one stencil entry's contributions to `node`, in a window of a full scatter
-    /// ([`NodalSums::momentum_only`] false).
-    #[inline]
-    pub fn add(
+    /// ([`NodalSums::momentum_only`] false); `A` is 0 where [`NodalSums::nonnegative`]
+    /// holds (`abs_mass` is then not summed), else 1.
+    #[inline(always)]
+    pub fn add<const A: usize>(
         &mut self,
         node: usize,
         mass: f64,
@@ -103,29 +238,31 @@ impl<const D: usize> Window<D> {
         momentum: SVector<f64, D>,
         force: SVector<f64, D>,
     ) {
-        let sums = &mut self.sums[node - self.lo];
-        sums.mass += mass;
-        sums.abs_mass += abs_mass;
-        sums.stiffness += stiffness;
-        sums.momentum += momentum;
-        sums.force += force;
+        let k = node - self.lo;
+        if A == 0 {
+            self.nonnegative_sums[k].add(mass, abs_mass, stiffness, momentum, force);
+        } else {
+            self.sums[k].add(mass, abs_mass, stiffness, momentum, force);
+        }
     }
 
     /// Adds one stencil entry's mass and momentum to `node`, in a window of a
     /// momentum-only scatter (MLS-MPM, whose momentum carries the force impulse: no
-    /// separate force or stiffness).
-    #[inline]
-    pub fn add_momentum(
+    /// separate force or stiffness); `A` as for [`Self::add`].
+    #[inline(always)]
+    pub fn add_momentum<const A: usize>(
         &mut self,
         node: usize,
         mass: f64,
         abs_mass: f64,
         momentum: SVector<f64, D>,
     ) {
-        let sums = &mut self.momentum_sums[node - self.lo];
-        sums.mass += mass;
-        sums.abs_mass += abs_mass;
-        sums.momentum += momentum;
+        let k = node - self.lo;
+        if A == 0 {
+            self.nonnegative_momentum_sums[k].add(mass, abs_mass, momentum);
+        } else {
+            self.momentum_sums[k].add(mass, abs_mass, momentum);
+        }
     }
 }
 
@@ -144,6 +281,10 @@ pub(crate) struct NodalSums<'a, const D: usize> {
     /// the force): the stiffness and force arrays are neither cleared nor summed, and
     /// stay as they are (zero, as no step of such a simulation writes them).
     pub momentum_only: bool,
+    /// Every shape-function value is ≥ 0 (`Kernel::nonnegative_values`), so Σ|N| m_p is
+    /// the mass: `abs_mass` is neither cleared nor summed, and the contributions must
+    /// come through `Window::add::<0>` / `add_momentum::<0>`.
+    pub nonnegative: bool,
 }
 
 /// Nodes per chunk of the merge and of the grid update (fixed, so that sums taken per
@@ -169,11 +310,7 @@ impl<const D: usize> Scatter<D> {
     /// their windows (grows with the nodes).
     pub fn bytes(&self) -> (usize, usize) {
         use crate::memory::bytes;
-        let windows: usize = self
-            .windows
-            .iter()
-            .map(|w| bytes(&w.sums) + bytes(&w.momentum_sums))
-            .sum();
+        let windows: usize = self.windows.iter().map(Window::bytes).sum();
         (
             bytes(&self.keys) + bytes(&self.order),
             windows
@@ -251,7 +388,7 @@ impl<const D: usize> Scatter<D> {
         E: Send,
     {
         let nodes = sums.mass.len();
-        let momentum_only = sums.momentum_only;
+        let (momentum_only, nonnegative) = (sums.momentum_only, sums.nonnegative);
         self.plan(ranges, nodes);
         let blocks = self.bounds.len() - 1;
         self.windows.resize_with(blocks, Window::default);
@@ -261,7 +398,7 @@ impl<const D: usize> Scatter<D> {
             .enumerate()
             .map(|(b, window)| {
                 let (lo, hi) = block_ranges[b];
-                window.reset(lo, hi, momentum_only);
+                window.reset(lo, hi, momentum_only, nonnegative);
                 contribute(&order[bounds[b]..bounds[b + 1]], window)
             })
             .reduce(|| Ok(()), |a, b| lowest_failure(a, b, |(), ()| ()))?;
@@ -276,61 +413,76 @@ impl<const D: usize> Scatter<D> {
                 sums.live[c] = true;
             }
         }
-        let live: &[bool] = sums.live;
         let windows = &self.windows[..blocks];
-        if sums.momentum_only {
-            sums.mass
-                .par_chunks_mut(NODE_CHUNK)
-                .zip(sums.abs_mass.par_chunks_mut(NODE_CHUNK))
-                .zip(sums.momentum.par_chunks_mut(NODE_CHUNK))
-                .enumerate()
-                .for_each(|(c, ((mass, abs_mass), momentum))| {
-                    if !live[c] {
-                        return;
-                    }
-                    mass.fill(0.0);
-                    abs_mass.fill(0.0);
-                    momentum.fill(SVector::zeros());
-                    let start = c * NODE_CHUNK;
-                    let end = start + mass.len();
-                    for_each_covered(windows, start, end, |j, k, w| {
-                        let sums = &w.momentum_sums[k];
-                        mass[j] += sums.mass;
-                        abs_mass[j] += sums.abs_mass;
-                        momentum[j] += sums.momentum;
-                    });
-                });
-            return Ok(());
+        match (momentum_only, nonnegative) {
+            (false, false) => merge::<D, NodeSums<D, 1>>(sums, windows),
+            (false, true) => merge::<D, NodeSums<D, 0>>(sums, windows),
+            (true, false) => merge::<D, MomentumSums<D, 1>>(sums, windows),
+            (true, true) => merge::<D, MomentumSums<D, 0>>(sums, windows),
         }
+        Ok(())
+    }
+}
+
+/// Sums the windows' records of kind `R` into `sums`, in parallel over the chunks of
+/// nodes; each node adds the windows covering it in block order.
+fn merge<const D: usize, R: Record<D>>(sums: NodalSums<'_, D>, windows: &[Window<D>]) {
+    let live: &[bool] = sums.live;
+    if sums.momentum_only {
+        // The stiffness and force arrays may be empty (the mass matrix's scatter).
         sums.mass
             .par_chunks_mut(NODE_CHUNK)
             .zip(sums.abs_mass.par_chunks_mut(NODE_CHUNK))
-            .zip(sums.stiffness.par_chunks_mut(NODE_CHUNK))
             .zip(sums.momentum.par_chunks_mut(NODE_CHUNK))
-            .zip(sums.force.par_chunks_mut(NODE_CHUNK))
             .enumerate()
-            .for_each(|(c, ((((mass, abs_mass), stiffness), momentum), force))| {
-                if !live[c] {
-                    return;
-                }
-                mass.fill(0.0);
-                abs_mass.fill(0.0);
-                stiffness.fill(0.0);
-                momentum.fill(SVector::zeros());
-                force.fill(SVector::zeros());
-                let start = c * NODE_CHUNK;
-                let end = start + mass.len();
-                for_each_covered(windows, start, end, |j, k, w| {
-                    let sums = &w.sums[k];
-                    mass[j] += sums.mass;
-                    abs_mass[j] += sums.abs_mass;
-                    stiffness[j] += sums.stiffness;
-                    momentum[j] += sums.momentum;
-                    force[j] += sums.force;
-                });
+            .for_each(|(c, ((mass, abs_mass), momentum))| {
+                let chunk = ChunkSums {
+                    mass,
+                    abs_mass,
+                    stiffness: &mut [],
+                    momentum,
+                    force: &mut [],
+                };
+                merge_chunk::<D, R>(c, chunk, live, windows);
             });
-        Ok(())
+        return;
     }
+    sums.mass
+        .par_chunks_mut(NODE_CHUNK)
+        .zip(sums.abs_mass.par_chunks_mut(NODE_CHUNK))
+        .zip(sums.stiffness.par_chunks_mut(NODE_CHUNK))
+        .zip(sums.momentum.par_chunks_mut(NODE_CHUNK))
+        .zip(sums.force.par_chunks_mut(NODE_CHUNK))
+        .enumerate()
+        .for_each(|(c, ((((mass, abs_mass), stiffness), momentum), force))| {
+            let chunk = ChunkSums {
+                mass,
+                abs_mass,
+                stiffness,
+                momentum,
+                force,
+            };
+            merge_chunk::<D, R>(c, chunk, live, windows);
+        });
+}
+
+/// Chunk `c` of the merge: cleared and summed if live, skipped otherwise.
+#[inline(always)]
+fn merge_chunk<const D: usize, R: Record<D>>(
+    c: usize,
+    mut chunk: ChunkSums<'_, D>,
+    live: &[bool],
+    windows: &[Window<D>],
+) {
+    if !live[c] {
+        return;
+    }
+    R::clear(&mut chunk);
+    let start = c * NODE_CHUNK;
+    let end = start + chunk.mass.len();
+    for_each_covered(windows, start, end, |j, k, w| {
+        R::records(w)[k].add_into(&mut chunk, j);
+    });
 }
 
 /// Calls `add(j, k, window)` for every node `start + j` of `start..end` a window covers

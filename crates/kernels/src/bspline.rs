@@ -210,6 +210,11 @@ impl<const D: usize> Kernel<D> for BSplineKernel<D> {
         })
     }
 
+    fn nonnegative_values(&self) -> bool {
+        // Products of per-axis B-spline weights, each ≥ 0 (zero beyond the support).
+        true
+    }
+
     fn recompute_stencils(&self) -> bool {
         // 3^D (4^D) products of per-axis weights: cheaper than storing ~1 KB per particle
         // in 3D and reading it back twice.

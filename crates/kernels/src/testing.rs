@@ -5,6 +5,8 @@
 //! - partition of unity Σ N_i = 1 and Σ ∇N_i = 0;
 //! - linear reproduction of positions Σ N_i x_i = x and gradients Σ x_i ∇N_iᵀ = I;
 //! - the second moment the kernel declares (`Kernel::constant_second_moment`), if any;
+//! - no negative value where the kernel declares its values never negative
+//!   (`Kernel::nonnegative_values`), with no -0.0 either (|N| m must be N m bit for bit);
 //! - node indices below `node_count`;
 //! - offsets x_i − x that match the node positions, and a `Kernel::node_range` equal
 //!   to the stencil's smallest and largest node;
@@ -75,6 +77,11 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
                 return Err(fail(format!(
                     "node {node} beyond the {} nodes",
                     kernel.node_count()
+                )));
+            }
+            if kernel.nonnegative_values() && n.is_sign_negative() {
+                return Err(fail(format!(
+                    "N = {n} at node {node}, though the kernel declares no negative values"
                 )));
             }
             let xi = kernel.node_position(node as usize);

@@ -201,7 +201,7 @@ fn umls_full_gradient_is_the_derivative_of_the_values() {
 }
 
 /// The suite catches what it checks: hat functions on [0, 1] pass it; scaled values, a
-/// wrong declared second moment, a node beyond the count, and no error outside each fail
+/// wrong declared second moment, negative values of a kernel declared nonnegative, a node beyond the count, and no error outside each fail
 /// it with the property named, as do wrong offsets, a wrong node range and a visitor
 /// that hands the entries over in another order.
 #[test]
@@ -215,6 +215,7 @@ fn the_public_suite_catches_broken_kernels() {
         offset_scale: f64,
         claimed_range: Option<(u32, u32)>,
         visits_reversed: bool,
+        nonnegative: bool,
     }
     impl Kernel<1> for Hat {
         type Cache = ();
@@ -229,6 +230,9 @@ fn the_public_suite_catches_broken_kernels() {
         }
         fn constant_second_moment(&self) -> Option<f64> {
             self.moment
+        }
+        fn nonnegative_values(&self) -> bool {
+            self.nonnegative
         }
         fn node_range(
             &self,
@@ -293,10 +297,29 @@ fn the_public_suite_catches_broken_kernels() {
         offset_scale: 1.0,
         claimed_range: None,
         visits_reversed: false,
+        nonnegative: false,
     };
     let points = [SVector::from([0.25]), SVector::from([0.6])];
     let outside = SVector::from([3.0]);
     check_kernel(&good, &points, outside).unwrap();
+    // Hats are never negative on [0, 1], and may say so; extended linearly beyond it
+    // they are (N_0 = −0.25 at 1.25), and then the declaration is caught.
+    let nonnegative = Hat {
+        nonnegative: true,
+        ..good
+    };
+    check_kernel(&nonnegative, &points, outside).unwrap();
+    let extended = Hat {
+        rejects_outside: false,
+        ..nonnegative
+    };
+    let negative = check_kernel(&extended, &[SVector::from([1.25])], outside)
+        .unwrap_err()
+        .message;
+    assert!(
+        negative.contains("declares no negative values"),
+        "{negative}"
+    );
     let failure = |k: Hat| check_kernel(&k, &points, outside).unwrap_err().message;
     assert!(failure(Hat { scale: 1.1, ..good }).contains("Σ N"));
     // x(1 − x) ≠ 0.3 at x = 0.25: a hat's second moment is not constant.

@@ -272,6 +272,15 @@ pub trait Kernel<const D: usize>: Send + Sync {
         None
     }
 
+    /// Whether N_i(x) ≥ 0 for every node and x, as for B-splines (not for MLS fits,
+    /// whose values can be negative, nor for linear elements, whose barycentric
+    /// coordinates round-off can make slightly negative at a facet). Then the engine
+    /// takes Σ_p |N_ip| m_p to be the nodal mass, bit for bit, instead of summing it
+    /// apart. Default `false`, which is always safe.
+    fn nonnegative_values(&self) -> bool {
+        false
+    }
+
     /// Per-node vectors ξ_i with which the internal force's shape-function gradients
     /// become ∇N_i + N_i (ξ_i − ξ̄_p), ξ̄_p = Σ_j N_j(x_p) ξ_j (an integration correction
     /// the kernel computed over its domain, for a gradient that is not the derivative of

@@ -145,6 +145,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 force: &mut [],
                 live: &mut solve.live,
                 momentum_only: true,
+                // |N|-mass summed whatever the kernel: this scatter is not the hot path.
+                nonnegative: false,
             };
             solve
                 .scatter
@@ -181,7 +183,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                 if affine {
                                     u += c * st.offset(e, kernel, &x);
                                 }
-                                window.add_momentum(
+                                window.add_momentum::<1>(
                                     st.nodes[e] as usize,
                                     n * m,
                                     n.abs() * m,

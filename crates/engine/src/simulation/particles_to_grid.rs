@@ -38,8 +38,9 @@ fn limited_affine<const D: usize>(
 
 /// One particle's contributions to the nodes of its stencil. `CORRECTED` is whether the
 /// kernel has an integration correction: a constant, so that the kernels without one
-/// (B-splines, whose visits are inlined here) keep an entry free of its branch.
-struct ScatterEntry<'w, const D: usize, T, const CORRECTED: bool> {
+/// (B-splines, whose visits are inlined here) keep an entry free of its branch. `A` is
+/// 0 for a kernel whose values are never negative (no |N|-mass summed), else 1.
+struct ScatterEntry<'w, const D: usize, T, const CORRECTED: bool, const A: usize> {
     window: &'w mut Window<D>,
     /// The affine matrix P2G spreads (zero without an affine transfer).
     affine: SMatrix<f64, D, D>,
@@ -58,8 +59,8 @@ struct ScatterEntry<'w, const D: usize, T, const CORRECTED: bool> {
     transfer: std::marker::PhantomData<T>,
 }
 
-impl<const D: usize, T: TransferScheme, const CORRECTED: bool> EntrySink<D>
-    for ScatterEntry<'_, D, T, CORRECTED>
+impl<const D: usize, T: TransferScheme, const CORRECTED: bool, const A: usize> EntrySink<D>
+    for ScatterEntry<'_, D, T, CORRECTED, A>
 {
     #[inline(always)]
     fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, r: &SVector<f64, D>) {
@@ -68,7 +69,7 @@ impl<const D: usize, T: TransferScheme, const CORRECTED: bool> EntrySink<D>
             // `velocity` is m (v + Δt a) and `affine` m C − Δt V τ D⁻¹ here.
             let momentum = self.velocity + self.affine * r;
             self.window
-                .add_momentum(node as usize, n * m, n.abs() * m, momentum * n);
+                .add_momentum::<A>(node as usize, n * m, n.abs() * m, momentum * n);
             return;
         }
         let mut mv = self.velocity;
@@ -82,7 +83,7 @@ impl<const D: usize, T: TransferScheme, const CORRECTED: bool> EntrySink<D>
         } else {
             gradient
         };
-        self.window.add(
+        self.window.add::<A>(
             node as usize,
             n * m,
             n.abs() * m,
@@ -94,17 +95,24 @@ impl<const D: usize, T: TransferScheme, const CORRECTED: bool> EntrySink<D>
 }
 
 impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
-    /// P2G into the grid's mass, |N|-mass, stiffness, momentum and force.
+    /// P2G into the grid's mass, |N|-mass (unless the kernel's values are never
+    /// negative), stiffness, momentum and force.
     pub(super) fn particles_to_grid(&mut self) -> Result<(), EngineError> {
-        match self.kernel.force_gradient_correction() {
-            Some(_) => self.scatter_particles::<true>(),
-            None => self.scatter_particles::<false>(),
+        let nonnegative = self.kernel.nonnegative_values();
+        self.grid.abs_mass_is_mass = nonnegative;
+        match (self.kernel.force_gradient_correction(), nonnegative) {
+            (Some(_), false) => self.scatter_particles::<true, 1>(),
+            (Some(_), true) => self.scatter_particles::<true, 0>(),
+            (None, false) => self.scatter_particles::<false, 1>(),
+            (None, true) => self.scatter_particles::<false, 0>(),
         }
     }
 
     /// [`Self::particles_to_grid`] for a kernel with (`CORRECTED`) or without an
-    /// integration correction.
-    fn scatter_particles<const CORRECTED: bool>(&mut self) -> Result<(), EngineError> {
+    /// integration correction, summing the |N|-mass (`A` = 1) or not (0).
+    fn scatter_particles<const CORRECTED: bool, const A: usize>(
+        &mut self,
+    ) -> Result<(), EngineError> {
         let stresses = &self.stress_buffer;
         let p = &self.particles;
         let (stencils, kernel, time, step) = (&self.stencils, &self.kernel, self.time, self.step);
@@ -119,6 +127,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             force: &mut g.force,
             live: &mut g.live,
             momentum_only: T::FUSED_FORCE,
+            nonnegative: A == 0,
         };
         // With a constant second moment (B-splines) the affine energy cannot grow as a
         // particle moves, and the limiter has nothing to do.
@@ -138,7 +147,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     let stress_volume = stresses[i] * volume;
                     let acceleration =
                         gravity + body_force.map_or(SVector::zeros(), |b| b(&x, time));
-                    let mut sink = ScatterEntry::<D, T, CORRECTED> {
+                    let mut sink = ScatterEntry::<D, T, CORRECTED, A> {
                         window,
                         affine: SMatrix::zeros(),
                         mass: m,
