@@ -50,6 +50,10 @@ pub(crate) struct Grid<const D: usize> {
     /// Whether P2G left `abs_mass` alone because every N ≥ 0 made it the mass
     /// (`Kernel::nonnegative_values`).
     pub abs_mass_is_mass: bool,
+    /// Whether P2G left `force` and `stiffness` alone (a momentum-only scatter,
+    /// MLS-MPM, whose momentum carries the force impulse): they are zero, and the
+    /// update does not read them.
+    pub momentum_only: bool,
     /// p_i = Σ N m_p (v_p + C_p (x_i − x_p)).
     pub momentum: Vec<SVector<f64, D>>,
     /// f_i: internal plus external force.
@@ -163,6 +167,7 @@ impl<const D: usize> Grid<D> {
             mass: vec![0.0; nodes],
             abs_mass: vec![0.0; nodes],
             abs_mass_is_mass: false,
+            momentum_only: false,
             momentum: vec![SVector::zeros(); nodes],
             force: vec![SVector::zeros(); nodes],
             stiffness: vec![0.0; nodes],
@@ -248,6 +253,7 @@ impl<const D: usize> Grid<D> {
         // In parallel over fixed chunks of nodes; the chunks' partial sums are added in
         // chunk order, so the report does not depend on the thread count.
         let round_off = self.round_off_mass;
+        let momentum_only = self.momentum_only;
         let local_damping = matches!(damping, Damping::Local { .. });
         let abs_mass = if self.abs_mass_is_mass {
             &self.mass
@@ -275,11 +281,18 @@ impl<const D: usize> Grid<D> {
                     let nodes = if live { mass.len() } else { 0 };
                     for i in 0..nodes {
                         let m = mass[i];
+                        // The zero arrays of a momentum-only scatter are not read: the
+                        // same values, less memory traffic.
+                        let (force_i, stiffness_i) = if momentum_only {
+                            (SVector::zeros(), 0.0)
+                        } else {
+                            (force[i], stiffness[i])
+                        };
                         if !active_node(m, abs_mass[i], round_off, cancellation_fraction) {
                             // A node with no mass at all can still carry a force (N = 0,
                             // ∇N ≠ 0).
                             dropped += m;
-                            redistributed += momentum[i] + force[i] * dt;
+                            redistributed += momentum[i] + force_i * dt;
                             velocity[i] = SVector::zeros();
                             new_velocity[i] = SVector::zeros();
                             continue;
@@ -287,11 +300,11 @@ impl<const D: usize> Grid<D> {
                         active += m;
                         let v = momentum[i] / m;
                         let f = if local_damping {
-                            damped(force[i], velocity[i], m, damping)
+                            damped(force_i, velocity[i], m, damping)
                         } else {
-                            damped(force[i], v, m, damping)
+                            damped(force_i, v, m, damping)
                         };
-                        let scaled_mass = dt * dt * modulus * stiffness[i];
+                        let scaled_mass = dt * dt * modulus * stiffness_i;
                         velocity[i] = v;
                         if scaled_mass > m.abs() {
                             // Selective mass scaling: the node moves as if it had mass

@@ -100,6 +100,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     pub(super) fn particles_to_grid(&mut self) -> Result<(), EngineError> {
         let nonnegative = self.kernel.nonnegative_values();
         self.grid.abs_mass_is_mass = nonnegative;
+        self.grid.momentum_only = T::FUSED_FORCE;
         match (self.kernel.force_gradient_correction(), nonnegative) {
             (Some(_), false) => self.scatter_particles::<true, 1>(),
             (Some(_), true) => self.scatter_particles::<true, 0>(),
