@@ -18,7 +18,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::{cargo, workspace_root};
+use crate::{cargo, target_dir, workspace_root};
 
 /// The stages of `summary.json`'s `stage_seconds`, in the step's order.
 const STAGES: [&str; 6] = [
@@ -268,12 +268,12 @@ pub fn render(base: &str, threads: usize, results: &[CaseResult]) -> String {
 pub fn compare(args: &[String]) -> Result<(), String> {
     let args = parse_args(args)?;
     let root = workspace_root();
-    let dir = root.join("target/compare");
+    let dir = target_dir().join("compare");
     let fail = |p: &Path, e: std::io::Error| format!("{}: {e}", p.display());
     std::fs::create_dir_all(&dir).map_err(|e| fail(&dir, e))?;
     let current = dir.join("umls-current");
     cargo(&["build", "--release", "-p", "umls-cli"])?;
-    let built = root.join("target/release/umls");
+    let built = target_dir().join("release/umls");
     std::fs::copy(&built, &current).map_err(|e| fail(&built, e))?;
     let base = build_revision(&root, &dir, &args.base)?;
     let mut results: Vec<CaseResult> = args

@@ -48,6 +48,15 @@ fn workspace_root() -> PathBuf {
         .to_path_buf()
 }
 
+/// Cargo's target directory: `CARGO_TARGET_DIR` where set (relative to the workspace,
+/// as cargo reads it), else the workspace's `target`.
+fn target_dir() -> PathBuf {
+    match std::env::var_os("CARGO_TARGET_DIR") {
+        Some(dir) if !dir.is_empty() => workspace_root().join(dir),
+        _ => workspace_root().join("target"),
+    }
+}
+
 fn cargo(args: &[&str]) -> Result<(), String> {
     eprintln!("xtask: cargo {}", args.join(" "));
     let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
@@ -134,8 +143,9 @@ fn bench(args: &[String]) -> Result<(), String> {
         cargo(&criterion)?;
     }
     cargo(&["build", "--release", "-p", "umls-cli"])?;
-    let out = root.join("target/report");
-    let exe = root.join("target/release/umls");
+    let target = target_dir();
+    let out = target.join("report");
+    let exe = target.join("release/umls");
     let mut command = Command::new(&exe);
     command
         .current_dir(&root)
@@ -147,7 +157,7 @@ fn bench(args: &[String]) -> Result<(), String> {
         .arg("--out")
         .arg(&out)
         .arg("--criterion")
-        .arg(root.join("target/criterion"))
+        .arg(target.join("criterion"))
         .args([
             "--criterion-current",
             args.save_baseline.as_deref().unwrap_or("new"),
