@@ -18,7 +18,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::{cargo, target_dir, workspace_root};
+use crate::{cargo, option_value, target_dir, workspace_root};
 
 /// The stages of `summary.json`'s `stage_seconds`, in the step's order.
 const STAGES: [&str; 6] = [
@@ -76,11 +76,8 @@ pub fn parse_args(args: &[String]) -> Result<CompareArgs, String> {
     };
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
-        let mut value = |name: &str| {
-            rest.next()
-                .cloned()
-                .ok_or_else(|| format!("compare: {name} needs a value"))
-        };
+        let mut value =
+            |name: &str| option_value(&mut rest, || format!("compare: {name} needs a value"));
         let number = |name: &str, text: String| {
             text.parse::<usize>()
                 .ok()

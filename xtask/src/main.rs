@@ -108,15 +108,20 @@ struct BenchArgs {
     docs: bool,
 }
 
+/// The value after an option, or `missing()` as the error where the arguments end.
+fn option_value(
+    rest: &mut std::slice::Iter<'_, String>,
+    missing: impl FnOnce() -> String,
+) -> Result<String, String> {
+    rest.next().cloned().ok_or_else(missing)
+}
+
 fn bench_args(args: &[String]) -> Result<BenchArgs, String> {
     let mut parsed = BenchArgs::default();
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
-        let mut value = |name: &str| {
-            rest.next()
-                .cloned()
-                .ok_or_else(|| format!("{name} needs a baseline name"))
-        };
+        let mut value =
+            |name: &str| option_value(&mut rest, || format!("{name} needs a baseline name"));
         match arg.as_str() {
             "--quick" => parsed.quick = true,
             "--no-criterion" => parsed.no_criterion = true,
