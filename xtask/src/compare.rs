@@ -36,11 +36,15 @@ const STAGE_LABELS: [&str; 6] = ["stencils", "P2G", "grid", "G2P", "constitutive
 /// The default cases: the engine's hot paths at a few seconds each on one thread. Each
 /// is the arguments of `umls run` after the scene (built-in names, so each program runs
 /// its own definition of the scene).
-const DEFAULT_CASES: [&str; 5] = [
+const DEFAULT_CASES: [&str; 6] = [
     // Taichi's scene with bspline2 and APIC (50 steps of 64,000 particles).
     "fluid-box-3d --end-time 0.01",
     // The same with MLS-MPM, the transfer of the side-by-side measurement.
     "fluid-box-3d --set transfer.kind=mls-mpm --end-time 0.02",
+    // The same with UMLS on the 1.57 M-tetrahedron lattice, where the step is bound by
+    // memory (20 steps; the mesh and the integration correction take about 8 s on one
+    // thread before them, untimed).
+    "fluid-box-3d --kernel umls --end-time 0.004",
     // UMLS in 3D on the Kuhn lattice with its integration correction.
     "hydrostatic-column-3d --kernel umls --end-time 0.1",
     // UMLS in 2D on jittered triangles, the whole scene (FLIP).
