@@ -18,7 +18,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::{cargo, option_value, target_dir, workspace_root};
+use crate::{cargo, cargo_in, option_value, target_dir, workspace_root};
 
 /// The stages of `summary.json`'s `stage_seconds`, in the step's order.
 const STAGES: [&str; 6] = [
@@ -396,16 +396,21 @@ fn build_revision(root: &Path, dir: &Path, revision: &str) -> Result<PathBuf, St
         "xtask: building {revision} ({commit}) in {}",
         tree.display()
     );
-    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .args(["build", "--release", "-p", "umls-cli", "--target-dir"])
-        .arg(dir.join("base-target"))
-        .current_dir(&tree)
-        .status()
-        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    let target = dir.join("base-target").to_string_lossy().to_string();
+    let built = cargo_in(
+        &tree,
+        &[
+            "build",
+            "--release",
+            "-p",
+            "umls-cli",
+            "--target-dir",
+            &target,
+        ],
+    );
+    // The worktree goes whether or not the build succeeded.
     let removed = git(&["worktree", "remove", "--force", &tree_arg]);
-    if !status.success() {
-        return Err(format!("building {revision} failed ({status})"));
-    }
+    built.map_err(|e| format!("building {revision}: {e}"))?;
     removed?;
     let program = dir.join("umls-base");
     let built = dir.join("base-target/release/umls");

@@ -58,10 +58,15 @@ fn target_dir() -> PathBuf {
 }
 
 fn cargo(args: &[&str]) -> Result<(), String> {
-    eprintln!("xtask: cargo {}", args.join(" "));
+    cargo_in(&workspace_root(), args)
+}
+
+/// Runs cargo with `args` in `dir` (another checkout's root, for `compare`).
+fn cargo_in(dir: &Path, args: &[&str]) -> Result<(), String> {
+    eprintln!("xtask: cargo {} (in {})", args.join(" "), dir.display());
     let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
         .args(args)
-        .current_dir(workspace_root())
+        .current_dir(dir)
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     if status.success() {

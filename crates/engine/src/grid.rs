@@ -179,11 +179,7 @@ impl<const D: usize> Grid<D> {
 
     /// Σ |N| m_p per node.
     pub fn abs_mass(&self) -> &[f64] {
-        if self.abs_mass_is_mass {
-            &self.mass
-        } else {
-            &self.abs_mass
-        }
+        abs_mass_of(&self.mass, &self.abs_mass, self.abs_mass_is_mass)
     }
 
     /// Whether node `i` carries a velocity (see the module docs).
@@ -255,11 +251,8 @@ impl<const D: usize> Grid<D> {
         let round_off = self.round_off_mass;
         let momentum_only = self.momentum_only;
         let local_damping = matches!(damping, Damping::Local { .. });
-        let abs_mass = if self.abs_mass_is_mass {
-            &self.mass
-        } else {
-            &self.abs_mass
-        };
+        // Not through `Self::abs_mass`, which would borrow the whole grid.
+        let abs_mass = abs_mass_of(&self.mass, &self.abs_mass, self.abs_mass_is_mass);
         let partials: Vec<(f64, SVector<f64, D>, usize, f64)> = self
             .mass
             .par_chunks(NODE_CHUNK)
@@ -351,6 +344,12 @@ impl<const D: usize> Grid<D> {
         }
         report
     }
+}
+
+/// Σ |N| m_p per node from the grid's arrays: the mass itself where P2G did not sum it
+/// apart (`is_mass`, a kernel whose values are never negative).
+fn abs_mass_of<'a>(mass: &'a [f64], abs_mass: &'a [f64], is_mass: bool) -> &'a [f64] {
+    if is_mass { mass } else { abs_mass }
 }
 
 /// Whether a node with mass `m` and Σ|N| m_p = `abs_mass` carries velocity: above the

@@ -93,10 +93,38 @@ impl<const D: usize, const A: usize> MomentumSums<D, A> {
     }
 }
 
-/// A window record's share of the nodal sums, added into the chunk of nodes it falls in.
-trait Record<const D: usize>: Copy + Send + Sync {
+/// Where a window keeps its records of one kind.
+trait InWindow<const D: usize>: Sized {
     /// The window's records of this kind.
     fn records(window: &Window<D>) -> &[Self];
+}
+
+impl<const D: usize> InWindow<D> for NodeSums<D, 1> {
+    fn records(window: &Window<D>) -> &[Self] {
+        &window.sums
+    }
+}
+
+impl<const D: usize> InWindow<D> for NodeSums<D, 0> {
+    fn records(window: &Window<D>) -> &[Self] {
+        &window.nonnegative_sums
+    }
+}
+
+impl<const D: usize> InWindow<D> for MomentumSums<D, 1> {
+    fn records(window: &Window<D>) -> &[Self] {
+        &window.momentum_sums
+    }
+}
+
+impl<const D: usize> InWindow<D> for MomentumSums<D, 0> {
+    fn records(window: &Window<D>) -> &[Self] {
+        &window.nonnegative_momentum_sums
+    }
+}
+
+/// A window record's share of the nodal sums, added into the chunk of nodes it falls in.
+trait Record<const D: usize>: InWindow<D> + Copy + Send + Sync {
     /// Zeroes the fields these records sum, over a chunk.
     fn clear(chunk: &mut ChunkSums<'_, D>);
     /// Adds the record to node `j` of the chunk.
@@ -112,30 +140,15 @@ struct ChunkSums<'a, const D: usize> {
     force: &'a mut [SVector<f64, D>],
 }
 
-impl<const D: usize> Record<D> for NodeSums<D, 1> {
-    fn records(window: &Window<D>) -> &[Self] {
-        &window.sums
-    }
-    fn clear(chunk: &mut ChunkSums<'_, D>) {
-        NodeSums::<D, 0>::clear(chunk);
-        chunk.abs_mass.fill(0.0);
-    }
-    #[inline(always)]
-    fn add_into(&self, chunk: &mut ChunkSums<'_, D>, j: usize) {
-        chunk.mass[j] += self.mass;
-        chunk.abs_mass[j] += self.abs_mass[0];
-        chunk.stiffness[j] += self.stiffness;
-        chunk.momentum[j] += self.momentum;
-        chunk.force[j] += self.force;
-    }
-}
-
-impl<const D: usize> Record<D> for NodeSums<D, 0> {
-    fn records(window: &Window<D>) -> &[Self] {
-        &window.nonnegative_sums
-    }
+impl<const D: usize, const A: usize> Record<D> for NodeSums<D, A>
+where
+    Self: InWindow<D>,
+{
     fn clear(chunk: &mut ChunkSums<'_, D>) {
         chunk.mass.fill(0.0);
+        if A > 0 {
+            chunk.abs_mass.fill(0.0);
+        }
         chunk.stiffness.fill(0.0);
         chunk.momentum.fill(SVector::zeros());
         chunk.force.fill(SVector::zeros());
@@ -143,39 +156,32 @@ impl<const D: usize> Record<D> for NodeSums<D, 0> {
     #[inline(always)]
     fn add_into(&self, chunk: &mut ChunkSums<'_, D>, j: usize) {
         chunk.mass[j] += self.mass;
+        for sum in &self.abs_mass {
+            chunk.abs_mass[j] += sum;
+        }
         chunk.stiffness[j] += self.stiffness;
         chunk.momentum[j] += self.momentum;
         chunk.force[j] += self.force;
     }
 }
 
-impl<const D: usize> Record<D> for MomentumSums<D, 1> {
-    fn records(window: &Window<D>) -> &[Self] {
-        &window.momentum_sums
-    }
-    fn clear(chunk: &mut ChunkSums<'_, D>) {
-        MomentumSums::<D, 0>::clear(chunk);
-        chunk.abs_mass.fill(0.0);
-    }
-    #[inline(always)]
-    fn add_into(&self, chunk: &mut ChunkSums<'_, D>, j: usize) {
-        chunk.mass[j] += self.mass;
-        chunk.abs_mass[j] += self.abs_mass[0];
-        chunk.momentum[j] += self.momentum;
-    }
-}
-
-impl<const D: usize> Record<D> for MomentumSums<D, 0> {
-    fn records(window: &Window<D>) -> &[Self] {
-        &window.nonnegative_momentum_sums
-    }
+impl<const D: usize, const A: usize> Record<D> for MomentumSums<D, A>
+where
+    Self: InWindow<D>,
+{
     fn clear(chunk: &mut ChunkSums<'_, D>) {
         chunk.mass.fill(0.0);
+        if A > 0 {
+            chunk.abs_mass.fill(0.0);
+        }
         chunk.momentum.fill(SVector::zeros());
     }
     #[inline(always)]
     fn add_into(&self, chunk: &mut ChunkSums<'_, D>, j: usize) {
         chunk.mass[j] += self.mass;
+        for sum in &self.abs_mass {
+            chunk.abs_mass[j] += sum;
+        }
         chunk.momentum[j] += self.momentum;
     }
 }
