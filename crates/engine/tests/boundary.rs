@@ -28,7 +28,7 @@ fn slope() -> Arc<SimplexMesh<2>> {
 }
 
 /// 2×2 particles per cell in the block [0.6, 1.4] × [0, 0.4] of the unrotated rectangle.
-fn block() -> Particles<2, (), HostCache> {
+fn block() -> Particles<2, (), HostCache<2>> {
     let rotation = Rotation2::new(THETA);
     let centre = Vector2::new(1.0, 0.5);
     let mut x = Vec::new();
@@ -43,7 +43,7 @@ fn block() -> Particles<2, (), HostCache> {
 }
 
 /// Tangential momentum over M g sinθ t, and the centroid's normal displacement.
-fn slide<K: Kernel<2, Cache = HostCache>>(kernel: K, mesh: &SimplexMesh<2>) -> (f64, f64) {
+fn slide<K: Kernel<2, Cache = HostCache<2>>>(kernel: K, mesh: &SimplexMesh<2>) -> (f64, f64) {
     let material = NeoHookean {
         parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
     };

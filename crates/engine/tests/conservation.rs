@@ -141,7 +141,7 @@ fn leaving_the_mesh_names_the_particle() {
     let material = NeoHookean {
         parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
     };
-    let mut particles = disk::<umls_kernels::HostCache>();
+    let mut particles = disk::<umls_kernels::HostCache<2>>();
     particles
         .velocity
         .iter_mut()
@@ -172,7 +172,7 @@ fn leaving_the_mesh_names_the_particle() {
             LinearFeKernel::new(mesh()),
             material,
             Pic,
-            disk::<umls_kernels::HostCache>(),
+            disk::<umls_kernels::HostCache<2>>(),
             StepSettings::new(-1.0)
         )
         .is_err()

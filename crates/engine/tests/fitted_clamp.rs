@@ -29,7 +29,7 @@ fn mesh(angle: f64) -> Arc<SimplexMesh<2>> {
 }
 
 /// The beam [−0.5, 2.5] × [0, 0.5], 0.125 apart; the part at x < 0 is embedded.
-fn beam() -> Particles<2, (), HostCache> {
+fn beam() -> Particles<2, (), HostCache<2>> {
     let mut x = Vec::new();
     for i in 0..24 {
         for j in 0..4 {

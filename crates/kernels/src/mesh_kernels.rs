@@ -28,7 +28,11 @@ macro_rules! mesh_nodes {
             self.mesh.min_height()
         }
 
-        fn domain_exit(&self, x: &SVector<f64, D>, cache: &HostCache) -> Option<DomainExit<D>> {
+        fn domain_exit(
+            &self,
+            x: &SVector<f64, D>,
+            cache: &mut HostCache<D>,
+        ) -> Option<DomainExit<D>> {
             exit(&self.mesh, x, cache)
         }
     };
@@ -38,19 +42,30 @@ macro_rules! mesh_nodes {
 /// until it would cross a boundary facet; that facet, and the last simplex's point on it
 /// (negative barycentric coordinates clamped to zero). `None` inside the mesh (or behind
 /// a concavity, where the walk is not the way out), and before the first location.
+///
+/// The walk is [`SimplexMesh::walk`]'s, so where it finds `x` inside a simplex, that
+/// simplex and its coordinates are what the next location of `x` from the cached host
+/// computes: they go into `cache` for it ([`HostCache`]).
 fn exit<const D: usize>(
     mesh: &SimplexMesh<D>,
     x: &SVector<f64, D>,
-    cache: &HostCache,
+    cache: &mut HostCache<D>,
 ) -> Option<DomainExit<D>> {
     /// A particle moves at most about a cell per step: a few simplices of walk.
     const MAX_STEPS: usize = 64;
-    let mut host = cache.0? as usize;
+    let mut host = cache.host? as usize;
     let mut found = None;
     for _ in 0..MAX_STEPS {
         let lambda = mesh.barycentric(host, x);
         let crossed = lambda.argmin();
         if lambda.as_slice()[crossed] >= -umls_mesh::INSIDE_TOLERANCE {
+            cache.remember(
+                x,
+                Located {
+                    simplex: host as u32,
+                    barycentric: lambda,
+                },
+            );
             return None;
         }
         match mesh.topology().neighbor(host, crossed) {
@@ -91,15 +106,55 @@ fn exit<const D: usize>(
     })
 }
 
-/// The host simplex a particle was last found in (`None` before the first location).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct HostCache(pub Option<u32>);
+/// Where a particle was last found in a mesh: its host simplex (`None` before the first
+/// location), and possibly a location found ahead of time.
+///
+/// G2P's domain-exit walk ([`Kernel::domain_exit`]) evaluates the moved particle's
+/// barycentric coordinates in its host, the walk the next step's location repeats. Each
+/// evaluation loads the host's inverse map, which the step's other traffic has evicted
+/// by then (a cache miss per particle, about 5 % of a UMLS step on the fluid box). So
+/// the walk leaves its result here, keyed by the position it was found for (bit for
+/// bit), and the next location of that same position takes it instead of walking again:
+/// the same simplex and coordinates, so the same bits.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct HostCache<const D: usize> {
+    /// The simplex the particle was last found in.
+    pub host: Option<u32>,
+    /// A location of the position stored with it, found by a walk from `host`.
+    ahead: Option<(SVector<f64, D>, Located<D>)>,
+}
+
+impl<const D: usize> HostCache<D> {
+    /// A cache holding `host` and no location found ahead.
+    pub fn at(host: u32) -> Self {
+        Self {
+            host: Some(host),
+            ahead: None,
+        }
+    }
+
+    /// Keeps `located`, the walk's result for `x`, for the next location of `x`.
+    fn remember(&mut self, x: &SVector<f64, D>, located: Located<D>) {
+        self.host = Some(located.simplex);
+        self.ahead = Some((*x, located));
+    }
+
+    /// The location kept for exactly `x`, if any; the kept location is used up either
+    /// way, since the host it was found from is about to change.
+    fn take_ahead(&mut self, x: &SVector<f64, D>) -> Option<Located<D>> {
+        let (at, located) = self.ahead.take()?;
+        at.iter()
+            .zip(x.iter())
+            .all(|(a, b)| a.to_bits() == b.to_bits())
+            .then_some(located)
+    }
+}
 
 /// Locates `x` walking from the cached host (BVH on the first call) and updates the cache.
 fn locate<const D: usize>(
     mesh: &SimplexMesh<D>,
     x: &SVector<f64, D>,
-    cache: &mut HostCache,
+    cache: &mut HostCache<D>,
 ) -> Result<u32, KernelError> {
     locate_with_coordinates(mesh, x, cache).map(|located| located.simplex)
 }
@@ -108,16 +163,19 @@ fn locate<const D: usize>(
 fn locate_with_coordinates<const D: usize>(
     mesh: &SimplexMesh<D>,
     x: &SVector<f64, D>,
-    cache: &mut HostCache,
+    cache: &mut HostCache<D>,
 ) -> Result<Located<D>, KernelError> {
-    let found = match cache.0 {
+    if let Some(located) = cache.take_ahead(x) {
+        return Ok(located);
+    }
+    let found = match cache.host {
         Some(host) => mesh.locate_from(x, host),
         None => mesh.locate(x),
     }
     .ok_or_else(|| KernelError::OutsideDomain {
         point: x.iter().copied().collect(),
     })?;
-    cache.0 = Some(found.simplex);
+    cache.host = Some(found.simplex);
     Ok(found)
 }
 
@@ -284,14 +342,14 @@ where
     B: PolynomialBasis<D, N>,
     W: WeightFunction,
 {
-    type Cache = HostCache;
+    type Cache = HostCache<D>;
 
     mesh_nodes!();
 
     fn stencil(
         &self,
         x: &SVector<f64, D>,
-        cache: &mut HostCache,
+        cache: &mut HostCache<D>,
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError> {
         let located = locate_with_coordinates(&self.mesh, x, cache)?;
@@ -312,7 +370,7 @@ where
     fn node_range(
         &self,
         x: &SVector<f64, D>,
-        cache: &mut HostCache,
+        cache: &mut HostCache<D>,
         _scratch: &mut Stencil<D>,
     ) -> Result<(u32, u32), KernelError> {
         let host = locate(&self.mesh, x, cache)?;
@@ -336,7 +394,7 @@ where
     fn factor_stencil(
         &self,
         x: &SVector<f64, D>,
-        cache: &mut HostCache,
+        cache: &mut HostCache<D>,
         scratch: &mut Stencil<D>,
         particle: &mut [f64],
         entries: &mut Vec<f64>,
@@ -372,7 +430,7 @@ where
     fn visit_factored<F>(
         &self,
         x: &SVector<f64, D>,
-        cache: &HostCache,
+        cache: &HostCache<D>,
         particle: &[f64],
         entries: &[f64],
         visit: F,
@@ -380,7 +438,7 @@ where
     where
         F: FnMut(u32, f64, &SVector<f64, D>, &SVector<f64, D>),
     {
-        let host = cache.0.ok_or_else(|| KernelError::OutsideDomain {
+        let host = cache.host.ok_or_else(|| KernelError::OutsideDomain {
             point: x.iter().copied().collect(),
         })?;
         // No closure around `visit` (an `and_then`): it would keep `visit` from being
@@ -411,14 +469,14 @@ impl<const D: usize> LinearFeKernel<D> {
 }
 
 impl<const D: usize> Kernel<D> for LinearFeKernel<D> {
-    type Cache = HostCache;
+    type Cache = HostCache<D>;
 
     mesh_nodes!();
 
     fn stencil(
         &self,
         x: &SVector<f64, D>,
-        cache: &mut HostCache,
+        cache: &mut HostCache<D>,
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError> {
         let host = locate(&self.mesh, x, cache)? as usize;
@@ -435,5 +493,83 @@ impl<const D: usize> Kernel<D> for LinearFeKernel<D> {
             out.push(v, l, *g, self.mesh.vertex(v as usize) - x);
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use nalgebra::SVector;
+    use umls_mesh::generate::{Diagonal, Lattice};
+    use umls_transfer::{Kernel, Stencil};
+
+    use super::{HostCache, LinearFeKernel, UmlsMeshKernel};
+
+    type Umls2 = UmlsMeshKernel<2, 3>;
+
+    fn mesh() -> Arc<umls_mesh::SimplexMesh<2>> {
+        Arc::new(
+            Lattice::new([0.0, 0.0], [1.0, 1.0], [8, 8])
+                .jitter(0.2, 7)
+                .triangles(Diagonal::Alternating)
+                .expect("mesh"),
+        )
+    }
+
+    /// The exit walk keeps the location of the position it was given, in the simplex
+    /// and with the coordinates a walk from the old host finds; only that exact
+    /// position takes it, once.
+    #[test]
+    fn the_exit_walk_keeps_the_location_of_exactly_its_position() {
+        let kernel = Umls2::new(mesh());
+        let (a, b) = (SVector::from([0.31, 0.42]), SVector::from([0.37, 0.47]));
+        let mut cache = HostCache::default();
+        let mut st = Stencil::new();
+        kernel.stencil(&a, &mut cache, &mut st).expect("inside");
+        let old = cache.host.expect("located");
+        assert!(kernel.domain_exit(&b, &mut cache).is_none());
+        let walked = kernel.mesh().locate_from(&b, old).expect("inside");
+        let kept = cache.ahead.expect("kept").1;
+        assert_eq!(kept, walked);
+        assert_eq!(cache.host, Some(walked.simplex));
+        // Another position (by one ulp) does not take it, and uses it up.
+        let mut other = cache;
+        let nudged = SVector::from([b[0], b[1] + f64::EPSILON * b[1]]);
+        assert!(other.take_ahead(&nudged).is_none());
+        assert!(other.ahead.is_none());
+        assert_eq!(cache.take_ahead(&b), Some(walked));
+        assert!(cache.take_ahead(&b).is_none());
+    }
+
+    /// After the exit walk, a stencil at the walked position and one elsewhere are both
+    /// those of a fresh cache, for UMLS and linear FE.
+    #[test]
+    fn stencils_after_the_exit_walk_are_those_of_a_fresh_cache() {
+        let mesh = mesh();
+        let umls = Umls2::new(mesh.clone());
+        let fe = LinearFeKernel::new(mesh);
+        let (a, b, c) = (
+            SVector::from([0.31, 0.42]),
+            SVector::from([0.37, 0.47]),
+            SVector::from([0.52, 0.18]),
+        );
+        for target in [b, c] {
+            let (mut st, mut fresh) = (Stencil::new(), Stencil::new());
+            let mut cache = HostCache::default();
+            umls.stencil(&a, &mut cache, &mut st).expect("inside");
+            assert!(umls.domain_exit(&b, &mut cache).is_none());
+            umls.stencil(&target, &mut cache, &mut st).expect("inside");
+            umls.stencil(&target, &mut HostCache::default(), &mut fresh)
+                .expect("inside");
+            assert_eq!(st, fresh);
+            let mut cache = HostCache::default();
+            fe.stencil(&a, &mut cache, &mut st).expect("inside");
+            assert!(fe.domain_exit(&b, &mut cache).is_none());
+            fe.stencil(&target, &mut cache, &mut st).expect("inside");
+            fe.stencil(&target, &mut HostCache::default(), &mut fresh)
+                .expect("inside");
+            assert_eq!(st, fresh);
+        }
     }
 }

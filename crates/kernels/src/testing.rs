@@ -10,7 +10,10 @@
 //! - node indices below `node_count`;
 //! - offsets x_i − x that match the node positions, and a `Kernel::node_range` equal
 //!   to the stencil's smallest and largest node;
-//! - the same stencil from a fresh location cache as from a warm one;
+//! - the same stencil from a fresh location cache as from a warm one, also when
+//!   `Kernel::domain_exit` (which an engine calls with a particle's new position) has
+//!   first left in the warm cache what it found at the point, and no domain exit for a
+//!   point inside the domain;
 //! - `Kernel::visit_stencil` handing over the stencil's entries in order, bit for bit;
 //! - factored stencils (`Kernel::factor_layout`) of the declared layout, rebuilt by
 //!   `Kernel::visit_factored` into the stencil's entries, with its node range; and
@@ -65,6 +68,14 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
             point: x.iter().copied().collect(),
             message,
         };
+        // As in G2P: the particle moves to x, the kernel looks for a domain exit there
+        // (and may keep what it found for the next stencil), then the stencil at x.
+        if let Some(exit) = kernel.domain_exit(x, &mut cache) {
+            return Err(fail(format!(
+                "a domain exit through facet {:?} for a point inside the domain",
+                exit.facet.iter().take(exit.facet_len).collect::<Vec<_>>()
+            )));
+        }
         kernel
             .stencil(x, &mut cache, &mut st)
             .map_err(|e| fail(format!("no stencil inside the domain: {e}")))?;

@@ -253,7 +253,7 @@ fn pure_flip_on_linear_elements_stays_bounded() {
         kernel,
         bar.material().unwrap(),
         Flip { alpha: 1.0 },
-        bar.particles::<HostCache>(),
+        bar.particles::<HostCache<1>>(),
         StepSettings::new(dt),
     )
     .unwrap();
@@ -275,13 +275,13 @@ fn analytic_reference_and_time_step() {
     assert!((steps as f64 * dt - 2.0 * std::f64::consts::PI / bar.omega()).abs() < 1e-9);
     assert!(dt <= 0.1 * bar.dx() / 10.0);
     // 13 particles and their 13 mirror images.
-    assert_eq!(bar.particles::<HostCache>().len(), 26);
+    assert_eq!(bar.particles::<HostCache<1>>().len(), 26);
     assert_eq!(
         VibratingBar {
             fixed_end: FixedEnd::Node,
             ..bar
         }
-        .particles::<HostCache>()
+        .particles::<HostCache<1>>()
         .len(),
         13
     );

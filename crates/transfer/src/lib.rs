@@ -294,8 +294,12 @@ pub trait Kernel<const D: usize>: Send + Sync {
 
     /// If `x` lies outside the domain, where it left it, seen from the location in
     /// `cache` (`None` inside, or where the kernel cannot tell). Mesh kernels use it to
-    /// hold particles at walls given as boundary node sets. Default: `None`.
-    fn domain_exit(&self, x: &SVector<f64, D>, cache: &Self::Cache) -> Option<DomainExit<D>> {
+    /// hold particles at walls given as boundary node sets. The engine calls it with a
+    /// particle's new position at the end of G2P, so a kernel may leave in `cache` what
+    /// it found there for the next [`Self::stencil`] of that position (the mesh kernels
+    /// keep the host and barycentric coordinates their walk computed), provided that
+    /// stencil comes out the same. Default: `None`.
+    fn domain_exit(&self, x: &SVector<f64, D>, cache: &mut Self::Cache) -> Option<DomainExit<D>> {
         let _ = (x, cache);
         None
     }

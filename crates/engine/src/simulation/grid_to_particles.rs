@@ -178,9 +178,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .zip(p.affine.par_chunks_mut(chunk))
             .zip(p.affine_moment.par_chunks_mut(chunk))
             .zip(velocity_gradients.par_chunks_mut(chunk))
+            .zip(p.cache.par_chunks_mut(chunk))
             .enumerate()
             .map(
-                |(c, ((((velocity, position), affine), moment), gradient))| {
+                |(c, (((((velocity, position), affine), moment), gradient), cache))| {
                     let mut scratch = Stencil::new();
                     // Work of gravity and body forces with the mean of old and new velocity:
                     // the trapezoidal rule balances the kinetic energy of a free fall exactly.
@@ -199,7 +200,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         let u = gather(
                             stencils,
                             i,
-                            &p.cache[i],
+                            &cache[k],
                             &mut scratch,
                             kernel,
                             &transfer,
@@ -223,7 +224,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                             corrections += 1;
                         }
                         if conditions {
-                            if let Some(exit) = kernel.domain_exit(&position[k], &p.cache[i]) {
+                            if let Some(exit) = kernel.domain_exit(&position[k], &mut cache[k]) {
                                 if Boundary::hold_at_facet(
                                     marks.get_or_init(|| boundary.node_marks(nodes)),
                                     &exit,
