@@ -20,7 +20,10 @@ use umls_io::csv::HistoryWriter;
 use umls_io::vtk::Encoding;
 use umls_kernels::{BSplineKernel, BSplineOrder, GradientKind, LinearFeKernel, UmlsMeshKernel};
 use umls_mesh::SimplexMesh;
-use umls_mls::{DEFAULT_SUPPORT_FACTOR, Linear, Profile, Quadratic, SupportRadius, UmlsKernel};
+use umls_mls::{
+    DEFAULT_SHARPENING, DEFAULT_SUPPORT_FACTOR, Linear, Profile, Quadratic, SharpenedBSpline,
+    SupportRadius, UmlsKernel,
+};
 use umls_transfer::Kernel;
 
 use crate::error::{CliError, Result};
@@ -225,6 +228,7 @@ fn run_dim<const D: usize, X: Dimension<D>>(
     match ctx.kernel {
         KernelKind::Umls
         | KernelKind::UmlsWendland
+        | KernelKind::UmlsSharp
         | KernelKind::UmlsWide
         | KernelKind::UmlsPaper
         | KernelKind::UmlsFullGradient
@@ -279,6 +283,10 @@ fn umls_settings<const D: usize>(
     let weight = match spec.weight.unwrap_or(preset.weight) {
         WeightSpec::CubicBspline => Profile::CubicBSpline,
         WeightSpec::Wendland => Profile::WendlandC2,
+        WeightSpec::Sharpened => Profile::Sharpened(
+            SharpenedBSpline::new(spec.sharpening.unwrap_or(DEFAULT_SHARPENING))
+                .map_err(|e| ctx.scene.value_error("kernel.sharpening", e.to_string()))?,
+        ),
     };
     let factor = spec.support_factor.unwrap_or(preset.factor);
     let support = match spec.support.unwrap_or(preset.support) {
@@ -330,6 +338,10 @@ fn umls_preset(kind: KernelKind) -> UmlsPreset {
         },
         KernelKind::UmlsWendland => UmlsPreset {
             weight: WeightSpec::Wendland,
+            ..default
+        },
+        KernelKind::UmlsSharp => UmlsPreset {
+            weight: WeightSpec::Sharpened,
             ..default
         },
         KernelKind::UmlsFullGradient => UmlsPreset {

@@ -170,6 +170,9 @@ pub enum KernelKind {
     UmlsQuadratic,
     /// UMLS with Wendland C² distance weights.
     UmlsWendland,
+    /// UMLS with sharpened distance weights: the cubic B-spline divided by 1 + (r/ε)²,
+    /// ε = 0.4 (`[kernel] sharpening`), closer to interpolating its nearest vertices.
+    UmlsSharp,
     /// UMLS with the wide per-vertex support (each vertex's farthest stencil reach), the
     /// default before the support study.
     UmlsWide,
@@ -201,6 +204,7 @@ impl KernelKind {
             KernelKind::Umls => "umls",
             KernelKind::UmlsQuadratic => "umls-quadratic",
             KernelKind::UmlsWendland => "umls-wendland",
+            KernelKind::UmlsSharp => "umls-sharp",
             KernelKind::UmlsWide => "umls-wide",
             KernelKind::UmlsPaper => "umls-paper",
             KernelKind::UmlsFullGradient => "umls-full-gradient",
@@ -225,6 +229,9 @@ pub struct KernelSpec {
     pub grid_spacing: Option<f64>,
     /// UMLS kernels: the distance-weight profile (default: the kernel name's).
     pub weight: Option<WeightSpec>,
+    /// UMLS kernels with `weight = "sharpened"`: ε of the divisor 1 + (r/ε)², in units
+    /// of the support radius (default 0.4).
+    pub sharpening: Option<f64>,
     /// UMLS kernels: how the support radius h_v is chosen (default: the kernel name's).
     pub support: Option<SupportSpec>,
     /// UMLS kernels: multiplier of the support radius (default: the kernel name's).
@@ -294,6 +301,7 @@ impl KernelKind {
             KernelKind::Umls
                 | KernelKind::UmlsQuadratic
                 | KernelKind::UmlsWendland
+                | KernelKind::UmlsSharp
                 | KernelKind::UmlsWide
                 | KernelKind::UmlsPaper
                 | KernelKind::UmlsFullGradient
@@ -311,6 +319,8 @@ pub enum WeightSpec {
     CubicBspline,
     /// Wendland's C² function.
     Wendland,
+    /// The cubic B-spline divided by 1 + (r/ε)², ε from `kernel.sharpening`.
+    Sharpened,
 }
 
 /// `kernel.gradient`: the UMLS shape-function gradient.

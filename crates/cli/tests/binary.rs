@@ -214,6 +214,7 @@ fn kernel_override_and_conservation() {
         "umls-wide",
         "umls-paper",
         "umls-wendland",
+        "umls-sharp",
         "umls-full-gradient",
         "umls-frozen-eta",
         "umls-uncorrected",

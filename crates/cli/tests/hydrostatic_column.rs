@@ -223,6 +223,37 @@ fn kernel_support_keys_override_the_preset() {
         .unwrap_err()
         .to_string();
     assert!(error.contains("kernel.support_factor"), "{error}");
+    let bad = variant(
+        "hydrostatic-column",
+        &[(
+            "kind = \"umls\"",
+            "kind = \"umls\"\nweight = \"sharpened\"\nsharpening = 0.0",
+        )],
+    );
+    let error = run(
+        &bad,
+        &options("column-umls-bad-sharpening", None, Some(0.01)),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(error.contains("kernel.sharpening"), "{error}");
+}
+
+/// Sharpened weights (`umls-sharp`) concentrate the fit on the nearest vertices and carry
+/// the column's walls better than the plain profile without the integration correction
+/// (measured: interior RMS 0.0058 against `umls-uncorrected`'s 0.019, bottom row 1.010).
+#[test]
+fn sharpened_weights_carry_the_column() {
+    let scene = Scene::load("hydrostatic-column").unwrap();
+    let report = run(
+        &scene,
+        &options("column-umls-sharp", Some(KernelKind::UmlsSharp), None),
+    )
+    .unwrap();
+    let s = &report.summary;
+    assert_eq!(s["kernel"], "umls-sharp");
+    assert!(metric(s, "stress_rms") < 0.01, "{s}");
+    assert!((metric(s, "bottom_row_ratio") - 1.0).abs() < 0.03, "{s}");
 }
 
 /// On unstructured tetrahedra the reconstructed gradient is not divergence-consistent

@@ -64,4 +64,6 @@ pub use stencil::{GradientKind, MAX_STENCIL, Stencil};
 pub use umls::{DEFAULT_SUPPORT_FACTOR, HOST_TOLERANCE, SupportRadius, UmlsKernel};
 #[cfg(feature = "mesh")]
 pub use umls_fit::UmlsFit;
-pub use weight::{CubicBSpline, Profile, WeightFunction, WendlandC2};
+pub use weight::{
+    CubicBSpline, DEFAULT_SHARPENING, Profile, SharpenedBSpline, WeightFunction, WendlandC2,
+};

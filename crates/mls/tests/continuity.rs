@@ -15,8 +15,8 @@ use nalgebra::SVector;
 use umls_mesh::SimplexMesh;
 use umls_mesh::generate::{Diagonal, Lattice};
 use umls_mls::{
-    CubicBSpline, GradientKind, Linear, PolynomialBasis, Profile, Quadratic, Stencil,
-    SupportRadius, UmlsKernel, WeightFunction,
+    CubicBSpline, DEFAULT_SHARPENING, GradientKind, Linear, PolynomialBasis, Profile, Quadratic,
+    SharpenedBSpline, Stencil, SupportRadius, UmlsKernel, WeightFunction,
 };
 
 const EPS: f64 = 1e-4;
@@ -263,7 +263,8 @@ fn umls_values_and_reconstructed_gradients_are_continuous() {
 }
 
 /// Every UMLS variant the CLI names (docs/umls-kernel.md): the wide per-vertex reach,
-/// the paper's global radius, Wendland weights, and the quadratic basis with its ridge,
+/// the paper's global radius, Wendland and sharpened weights, and the quadratic basis
+/// with its ridge,
 /// in 2D and 3D. Narrow supports make vertices enter and leave by their distance weight
 /// too; that weight is C² in x, so continuity holds as for the default.
 #[test]
@@ -284,6 +285,13 @@ fn every_umls_variant_is_continuous() {
             "narrow",
             Profile::CubicBSpline,
             SupportRadius::IncidentEdge { factor: 0.6 },
+        ),
+        (
+            "sharpened",
+            Profile::Sharpened(SharpenedBSpline {
+                epsilon: DEFAULT_SHARPENING,
+            }),
+            SupportRadius::default(),
         ),
     ];
     let tets = Lattice::new([0.0; 3], [1.0; 3], [3, 3, 3])

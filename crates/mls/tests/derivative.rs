@@ -8,8 +8,9 @@ use nalgebra::SVector;
 use proptest::prelude::*;
 use umls_mesh::SimplexMesh;
 use umls_mls::{
-    Conditioning, CubicBSpline, GradientKind, Linear, PolynomialBasis, Quadratic, Samples, Stencil,
-    SupportRadius, UmlsKernel, WeightFunction, WendlandC2, diminishing_factor, shape_functions,
+    Conditioning, CubicBSpline, DEFAULT_SHARPENING, GradientKind, Linear, PolynomialBasis,
+    Quadratic, Samples, SharpenedBSpline, Stencil, SupportRadius, UmlsKernel, WeightFunction,
+    WendlandC2, diminishing_factor, shape_functions,
 };
 
 fn check_fd<const D: usize, const N: usize, B: PolynomialBasis<D, N>, W: WeightFunction>(
@@ -112,6 +113,25 @@ fn weight_profile_derivatives() {
     }
     check(CubicBSpline);
     check(WendlandC2);
+    for epsilon in [0.2, DEFAULT_SHARPENING, 1.0] {
+        let sharp = SharpenedBSpline::new(epsilon).unwrap();
+        check(sharp);
+        // The B-spline divided by 1 + (r/ε)², computed independently.
+        for r in [0.0, 0.3, 0.9, 1.0, 1.5, 1.99] {
+            let expected =
+                CubicBSpline.evaluate(r).0 * epsilon * epsilon / (r * r + epsilon * epsilon);
+            assert!(
+                (sharp.evaluate(r).0 - expected).abs() < 1e-15,
+                "ε {epsilon}, r {r}"
+            );
+        }
+    }
+    // A wide ε is the plain spline to O(1/ε²).
+    let wide = SharpenedBSpline::new(1e4).unwrap();
+    assert!((wide.evaluate(1.0).0 - 1.0 / 6.0).abs() < 1e-8);
+    for bad in [0.0, -0.4, f64::NAN, f64::INFINITY] {
+        assert!(SharpenedBSpline::new(bad).is_err(), "ε = {bad} accepted");
+    }
     assert!((CubicBSpline.evaluate(0.0).0 - 2.0 / 3.0).abs() < 1e-15);
     assert!((CubicBSpline.evaluate(1.0).0 - 1.0 / 6.0).abs() < 1e-15);
 }

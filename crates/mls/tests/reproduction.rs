@@ -7,11 +7,12 @@ use nalgebra::{SMatrix, SVector};
 use proptest::prelude::*;
 use umls_mesh::SimplexMesh;
 use umls_mls::{
-    GradientKind, Linear, PolynomialBasis, Profile, Quadratic, Stencil, SupportRadius, UmlsKernel,
+    DEFAULT_SHARPENING, GradientKind, Linear, PolynomialBasis, Profile, Quadratic,
+    SharpenedBSpline, Stencil, SupportRadius, UmlsKernel,
 };
 
 /// The UMLS variants the CLI names (docs/umls-kernel.md): profile and radius rule.
-const VARIANTS: [(Profile, SupportRadius); 5] = [
+const VARIANTS: [(Profile, SupportRadius); 6] = [
     (
         Profile::CubicBSpline,
         SupportRadius::IncidentEdge { factor: 0.9 },
@@ -28,6 +29,12 @@ const VARIANTS: [(Profile, SupportRadius); 5] = [
     (
         Profile::CubicBSpline,
         SupportRadius::IncidentEdge { factor: 0.6 },
+    ),
+    (
+        Profile::Sharpened(SharpenedBSpline {
+            epsilon: DEFAULT_SHARPENING,
+        }),
+        SupportRadius::IncidentEdge { factor: 0.9 },
     ),
 ];
 
