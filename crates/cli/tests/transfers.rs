@@ -8,6 +8,19 @@ use umls_cli::schema::KernelKind;
 mod runs;
 use runs::{metric, options, variant};
 
+/// The disks' summary with `kernel` and transfer `kind` (α 0.99 where it blends), run in
+/// the output directory `prefix-KERNEL-KIND`.
+fn disks_with(kernel: KernelKind, kind: &str, prefix: &str) -> serde_json::Value {
+    let scene = variant(
+        "colliding-disks",
+        &[("kind = \"flip\"", &format!("kind = \"{kind}\""))],
+    );
+    let name = format!("{prefix}-{}-{kind}", kernel.name());
+    run(&scene, &options(&name, Some(kernel), None))
+        .unwrap()
+        .summary
+}
+
 /// At α = 0.99 the PIC part of FLIP is what dissipates (pure FLIP loses 3 % with UMLS
 /// and under 1 % with bspline2 by t = 3); with the affine field carried through P2G it
 /// filters only what that field does not hold, so APIC-FLIP loses less for every
@@ -15,19 +28,13 @@ use runs::{metric, options, variant};
 #[test]
 fn apic_flip_loses_less_energy_than_flip_on_the_disks() {
     let lost = |kernel: KernelKind, kind: &str| {
-        let scene = variant(
-            "colliding-disks",
-            &[("kind = \"flip\"", &format!("kind = \"{kind}\""))],
-        );
-        let name = format!("disks-{}-{kind}", kernel.name());
-        let report = run(&scene, &options(&name, Some(kernel), None)).unwrap();
+        let summary = disks_with(kernel, kind, "disks");
         assert_eq!(
-            report.summary["transfer"],
+            summary["transfer"],
             format!("{kind} (alpha 0.99)"),
-            "{}",
-            report.summary
+            "{summary}"
         );
-        -metric(&report.summary, "energy_change_final")
+        -metric(&summary, "energy_change_final")
     };
     for kernel in [KernelKind::Umls, KernelKind::Bspline2] {
         let (flip, apic_flip) = (lost(kernel, "flip"), lost(kernel, "apic-flip"));
@@ -93,19 +100,10 @@ fn consistent_mass_keeps_the_disks_energy_under_apic() {
 #[test]
 fn sharpened_weights_dissipate_like_quadratic_b_splines_under_apic() {
     let lost = |kernel: KernelKind, kind: &str| {
-        let scene = variant(
-            "colliding-disks",
-            &[("kind = \"flip\"", &format!("kind = \"{kind}\""))],
-        );
-        let name = format!("disks-sharp-{}-{kind}", kernel.name());
-        let report = run(&scene, &options(&name, Some(kernel), None)).unwrap();
-        assert_eq!(report.summary["status"], "completed", "{}", report.summary);
-        assert!(
-            metric(&report.summary, "energy_gain_max") < 1e-9,
-            "{}",
-            report.summary
-        );
-        -metric(&report.summary, "energy_change_final")
+        let summary = disks_with(kernel, kind, "disks-sharp");
+        assert_eq!(summary["status"], "completed", "{summary}");
+        assert!(metric(&summary, "energy_gain_max") < 1e-9, "{summary}");
+        -metric(&summary, "energy_change_final")
     };
     let sharp = lost(KernelKind::UmlsSharp, "apic");
     let plain = lost(KernelKind::UmlsUncorrected, "apic");
