@@ -120,33 +120,29 @@ fn exit<const D: usize>(
 pub struct HostCache<const D: usize> {
     /// The simplex the particle was last found in.
     pub host: Option<u32>,
-    /// A location of the position stored with it, found by a walk from `host`.
-    ahead: Option<(SVector<f64, D>, Located<D>)>,
+    /// A position found inside `host` by a walk, with its barycentric coordinates there.
+    ahead: Option<(SVector<f64, D>, Barycentric<D>)>,
 }
 
 impl<const D: usize> HostCache<D> {
-    /// A cache holding `host` and no location found ahead.
-    pub fn at(host: u32) -> Self {
-        Self {
-            host: Some(host),
-            ahead: None,
-        }
-    }
-
     /// Keeps `located`, the walk's result for `x`, for the next location of `x`.
     fn remember(&mut self, x: &SVector<f64, D>, located: Located<D>) {
         self.host = Some(located.simplex);
-        self.ahead = Some((*x, located));
+        self.ahead = Some((*x, located.barycentric));
     }
 
     /// The location kept for exactly `x`, if any; the kept location is used up either
-    /// way, since the host it was found from is about to change.
+    /// way, since the host it was found in is about to change.
     fn take_ahead(&mut self, x: &SVector<f64, D>) -> Option<Located<D>> {
-        let (at, located) = self.ahead.take()?;
-        at.iter()
+        let (at, barycentric) = self.ahead.take()?;
+        let same = at
+            .iter()
             .zip(x.iter())
-            .all(|(a, b)| a.to_bits() == b.to_bits())
-            .then_some(located)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        Some(Located {
+            simplex: self.host.filter(|_| same)?,
+            barycentric,
+        })
     }
 }
 
@@ -531,7 +527,7 @@ mod tests {
         assert!(kernel.domain_exit(&b, &mut cache).is_none());
         let walked = kernel.mesh().locate_from(&b, old).expect("inside");
         let kept = cache.ahead.expect("kept").1;
-        assert_eq!(kept, walked);
+        assert_eq!(kept, walked.barycentric);
         assert_eq!(cache.host, Some(walked.simplex));
         // Another position (by one ulp) does not take it, and uses it up.
         let mut other = cache;

@@ -201,9 +201,10 @@ fn umls_full_gradient_is_the_derivative_of_the_values() {
 }
 
 /// The suite catches what it checks: hat functions on [0, 1] pass it; scaled values, a
-/// wrong declared second moment, negative values of a kernel declared nonnegative, a node beyond the count, and no error outside each fail
-/// it with the property named, as do wrong offsets, a wrong node range and a visitor
-/// that hands the entries over in another order.
+/// wrong declared second moment, negative values of a kernel declared nonnegative, a
+/// node beyond the count, and no error outside each fail it with the property named, as
+/// do wrong offsets, a wrong node range and a visitor that hands the entries over in
+/// another order.
 #[test]
 fn the_public_suite_catches_broken_kernels() {
     #[derive(Clone, Copy)]

@@ -67,9 +67,9 @@ impl WeightFunction for WendlandC2 {
 /// at r = 0 too). The divisor concentrates the weight on the samples nearest the point,
 /// the more the smaller ε (with ε = 0.4 it is 7.25 at r = 1, about where a host's
 /// farther ring vertices lie), which brings an MLS fit closer to interpolating its
-/// nearest samples:
-/// what a particle-grid round trip filters shrinks with the stencil's effective width
-/// (docs/umls-kernel.md, *Sharpened weights*). ε → ∞ gives back [`CubicBSpline`].
+/// nearest samples: what a particle-grid round trip filters shrinks with the stencil's
+/// effective width (docs/umls-kernel.md, *Sharpened weights*). ε → ∞ gives back
+/// [`CubicBSpline`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SharpenedBSpline {
     /// ε, in units of the support radius h_v, > 0.
