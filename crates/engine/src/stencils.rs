@@ -411,13 +411,17 @@ impl<const D: usize> Stencils<D> {
             }
             Mode::Recompute => {
                 let mut cache = *cache;
-                // A closure with this one call site, so the kernel's loop inlines it (a
-                // closure called from two places stays a call, and its sums leave the
-                // registers).
+                // Inlined by force: a kernel may instantiate its loop more than once (a
+                // B-spline grid once per order), and a closure called from two places
+                // otherwise stays a call, its sums out of the registers.
                 kernel
-                    .visit_stencil(x, &mut cache, scratch, |node, n, gradient, offset| {
-                        sink.entry(node, n, gradient, offset)
-                    })
+                    .visit_stencil(
+                        x,
+                        &mut cache,
+                        scratch,
+                        #[inline(always)]
+                        |node, n, gradient, offset| sink.entry(node, n, gradient, offset),
+                    )
                     .map_err(|e| (p, e))
             }
         }
