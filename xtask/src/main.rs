@@ -11,12 +11,17 @@
 //!   working tree's speed against revision `REV` on the same machine, alternating short
 //!   runs of both builds, with stage times, ratios and whether the results stayed bit
 //!   for bit the same (`compare.rs`; report in `target/compare/compare.md`).
+//! - `peers [--rounds N] [--threads N] [--steps N] [--python PATH]`: the fluid box side
+//!   by side with Taichi's own example of the scene, alternating runs, throughput and
+//!   peak memory with ratios to the same round's Taichi run (`peers.rs`; Taichi installed
+//!   from PyPI into `target/peers/venv` on first use; report in `target/peers/peers.md`).
 //! - `deny`: `cargo deny check` (needs `cargo install cargo-deny`).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
 mod compare;
+mod peers;
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -24,10 +29,11 @@ fn main() -> ExitCode {
         Some("ci") => ci(),
         Some("bench") => bench(&args[1..]),
         Some("compare") => compare::compare(&args[1..]),
+        Some("peers") => peers::peers(&args[1..]),
         Some("deny") => cargo(&["deny", "check"]),
         _ => {
             eprintln!(
-                "usage: cargo xtask <ci | bench [--quick] [--no-criterion] [--save-baseline NAME | --baseline NAME] [--docs] | compare REV [--rounds N] [--threads N] [--case ARGS]... [--fail-above R] | deny>"
+                "usage: cargo xtask <ci | bench [--quick] [--no-criterion] [--save-baseline NAME | --baseline NAME] [--docs] | compare REV [--rounds N] [--threads N] [--case ARGS]... [--fail-above R] | peers [--rounds N] [--threads N] [--steps N] [--python PATH] | deny>"
             );
             return ExitCode::from(2);
         }
