@@ -18,7 +18,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::{cargo, cargo_in, option_value, target_dir, workspace_root};
+use crate::{cargo, cargo_in, option_value, positive_integer, target_dir, workspace_root};
 
 /// The stages of `summary.json`'s `stage_seconds`, in the step's order.
 const STAGES: [&str; 6] = [
@@ -82,12 +82,7 @@ pub fn parse_args(args: &[String]) -> Result<CompareArgs, String> {
     while let Some(arg) = rest.next() {
         let mut value =
             |name: &str| option_value(&mut rest, || format!("compare: {name} needs a value"));
-        let number = |name: &str, text: String| {
-            text.parse::<usize>()
-                .ok()
-                .filter(|&n| n > 0)
-                .ok_or_else(|| format!("compare: {name} takes a positive integer, not `{text}`"))
-        };
+        let number = |name: &str, text: String| positive_integer("compare", name, text);
         match arg.as_str() {
             "--rounds" => parsed.rounds = number("--rounds", value("--rounds")?)?,
             "--threads" => parsed.threads = number("--threads", value("--threads")?)?,
@@ -340,8 +335,20 @@ pub fn compare(args: &[String]) -> Result<(), String> {
 /// One run of `program` on `case` into `out`, with two frames only (frames are not
 /// timed, but writing them would lengthen the comparison).
 fn run_case(program: &Path, case: &str, threads: usize, out: &Path) -> Result<Timing, String> {
+    let text = run_summary(program, case, threads, out)?;
+    parse_summary(&text).map_err(|e| format!("{}: {e}", out.join("summary.json").display()))
+}
+
+/// Runs `program run CASE` (the scene and its arguments, split at white space) on
+/// `threads` threads into `out`, two frames only, and returns its `summary.json` text.
+pub fn run_summary(
+    program: &Path,
+    case: &str,
+    threads: usize,
+    out: &Path,
+) -> Result<String, String> {
     let mut words = case.split_whitespace();
-    let scene = words.next().ok_or("compare: an empty case")?;
+    let scene = words.next().ok_or("an empty case")?;
     let status = Command::new(program)
         .arg("run")
         .arg(scene)
@@ -360,9 +367,7 @@ fn run_case(program: &Path, case: &str, threads: usize, out: &Path) -> Result<Ti
         ));
     }
     let summary = out.join("summary.json");
-    let text =
-        std::fs::read_to_string(&summary).map_err(|e| format!("{}: {e}", summary.display()))?;
-    parse_summary(&text).map_err(|e| format!("{}: {e}", summary.display()))
+    std::fs::read_to_string(&summary).map_err(|e| format!("{}: {e}", summary.display()))
 }
 
 /// Builds `umls-cli` at `revision` in a detached worktree under `dir` (its target
@@ -421,10 +426,7 @@ fn build_revision(root: &Path, dir: &Path, revision: &str) -> Result<PathBuf, St
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn strings(args: &[&str]) -> Vec<String> {
-        args.iter().map(|s| s.to_string()).collect()
-    }
+    use crate::strings;
 
     #[test]
     fn arguments_are_read_and_checked() {

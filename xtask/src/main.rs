@@ -127,6 +127,20 @@ fn option_value(
     rest.next().cloned().ok_or_else(missing)
 }
 
+/// Owned copies of `args`, as the commands' parsers take them (tests).
+#[cfg(test)]
+fn strings(args: &[&str]) -> Vec<String> {
+    args.iter().map(|s| s.to_string()).collect()
+}
+
+/// `text` as a positive integer, or an error naming `command`'s option `name`.
+fn positive_integer(command: &str, name: &str, text: String) -> Result<usize, String> {
+    text.parse::<usize>()
+        .ok()
+        .filter(|&n| n > 0)
+        .ok_or_else(|| format!("{command}: {name} takes a positive integer, not `{text}`"))
+}
+
 fn bench_args(args: &[String]) -> Result<BenchArgs, String> {
     let mut parsed = BenchArgs::default();
     let mut rest = args.iter();

@@ -13,8 +13,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::compare::{median, parse_summary};
-use crate::{cargo, option_value, target_dir};
+use crate::compare::{median, parse_summary, run_summary};
+use crate::{cargo, option_value, positive_integer, target_dir};
 
 /// The Taichi release the measurements use (the one the engine's issue measured).
 const TAICHI: &str = "taichi==1.7.4";
@@ -63,12 +63,7 @@ pub fn parse_args(args: &[String]) -> Result<PeersArgs, String> {
     while let Some(arg) = rest.next() {
         let mut value =
             |name: &str| option_value(&mut rest, || format!("peers: {name} needs a value"));
-        let number = |name: &str, text: String| {
-            text.parse::<usize>()
-                .ok()
-                .filter(|&n| n > 0)
-                .ok_or_else(|| format!("peers: {name} takes a positive integer, not `{text}`"))
-        };
+        let number = |name: &str, text: String| positive_integer("peers", name, text);
         match arg.as_str() {
             "--rounds" => parsed.rounds = number("--rounds", value("--rounds")?)?,
             "--threads" => parsed.threads = number("--threads", value("--threads")?)?,
@@ -273,29 +268,13 @@ fn run_umls(
     args: &PeersArgs,
     out: &Path,
 ) -> Result<PeerRun, String> {
-    let end_time = args.steps as f64 * DT;
-    let status = Command::new(program)
-        .args(["run", "fluid-box-3d"])
-        .args(extra)
-        .args(["--set", "output.frames=2", "--quiet", "--end-time"])
-        .arg(end_time.to_string())
-        .arg("--threads")
-        .arg(args.threads.to_string())
-        .arg("--out")
-        .arg(out)
-        .stdout(std::process::Stdio::null())
-        .status()
-        .map_err(|e| format!("cannot run {}: {e}", program.display()))?;
-    if !status.success() {
-        return Err(format!(
-            "`umls run fluid-box-3d {}` failed ({status})",
-            extra.join(" ")
-        ));
-    }
-    let summary = out.join("summary.json");
-    let text =
-        std::fs::read_to_string(&summary).map_err(|e| format!("{}: {e}", summary.display()))?;
-    parse_umls_summary(&text).map_err(|e| format!("{}: {e}", summary.display()))
+    let case = format!(
+        "fluid-box-3d {} --end-time {}",
+        extra.join(" "),
+        args.steps as f64 * DT
+    );
+    let text = run_summary(program, &case, args.threads, out)?;
+    parse_umls_summary(&text).map_err(|e| format!("{}: {e}", out.join("summary.json").display()))
 }
 
 /// Sets up Taichi, builds `umls`, runs the rounds and writes `target/peers/peers.md`.
@@ -342,10 +321,7 @@ pub fn peers(args: &[String]) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn strings(args: &[&str]) -> Vec<String> {
-        args.iter().map(|s| s.to_string()).collect()
-    }
+    use crate::strings;
 
     #[test]
     fn arguments_are_read_and_checked() {
