@@ -9,6 +9,14 @@ use umls_cli::schema::KernelKind;
 mod runs;
 use runs::{History, metric, options, variant};
 
+/// The upright 2D column's summary with `kernel`, run in the output directory `name`.
+fn column_with(kernel: KernelKind, name: &str) -> serde_json::Value {
+    let scene = Scene::load("hydrostatic-column").unwrap();
+    run(&scene, &options(name, Some(kernel), None))
+        .unwrap()
+        .summary
+}
+
 /// Particles that start at the geostatic stress of the exact solution: one short step
 /// later every stress metric reads the closed form, in the upright scene and in the
 /// scene turned by 30° (where stresses and depths go through the frame), and nothing has
@@ -142,18 +150,9 @@ fn turned_column_on_its_mesh_is_the_upright_column() {
 /// below), which shows the scene-file names select what they say.
 #[test]
 fn the_wide_support_overloads_the_column_base() {
-    let scene = Scene::load("hydrostatic-column").unwrap();
-    let wide = run(
-        &scene,
-        &options("column-umls-wide", Some(KernelKind::UmlsWide), None),
-    )
-    .unwrap();
-    assert_eq!(wide.summary["kernel"], "umls-wide");
-    assert!(
-        metric(&wide.summary, "bottom_row_ratio") > 1.5,
-        "{}",
-        wide.summary
-    );
+    let wide = column_with(KernelKind::UmlsWide, "column-umls-wide");
+    assert_eq!(wide["kernel"], "umls-wide");
+    assert!(metric(&wide, "bottom_row_ratio") > 1.5, "{wide}");
 }
 
 /// The consistent mass matrix solved for the forces as well keeps the walls' reactions
@@ -244,13 +243,7 @@ fn kernel_support_keys_override_the_preset() {
 /// (measured: interior RMS 0.0058 against `umls-uncorrected`'s 0.019, bottom row 1.010).
 #[test]
 fn sharpened_weights_carry_the_column() {
-    let scene = Scene::load("hydrostatic-column").unwrap();
-    let report = run(
-        &scene,
-        &options("column-umls-sharp", Some(KernelKind::UmlsSharp), None),
-    )
-    .unwrap();
-    let s = &report.summary;
+    let s = &column_with(KernelKind::UmlsSharp, "column-umls-sharp");
     assert_eq!(s["kernel"], "umls-sharp");
     assert!(metric(s, "stress_rms") < 0.01, "{s}");
     assert!((metric(s, "bottom_row_ratio") - 1.0).abs() < 0.03, "{s}");

@@ -542,6 +542,25 @@ mod tests {
     /// those of a fresh cache, for UMLS and linear FE.
     #[test]
     fn stencils_after_the_exit_walk_are_those_of_a_fresh_cache() {
+        /// Located at `a`, walked to `b`, then the stencil at `target` against a fresh one.
+        fn check<K: Kernel<2, Cache = HostCache<2>>>(
+            kernel: &K,
+            a: SVector<f64, 2>,
+            b: SVector<f64, 2>,
+            target: SVector<f64, 2>,
+        ) {
+            let (mut st, mut fresh) = (Stencil::new(), Stencil::new());
+            let mut cache = HostCache::default();
+            kernel.stencil(&a, &mut cache, &mut st).expect("inside");
+            assert!(kernel.domain_exit(&b, &mut cache).is_none());
+            kernel
+                .stencil(&target, &mut cache, &mut st)
+                .expect("inside");
+            kernel
+                .stencil(&target, &mut HostCache::default(), &mut fresh)
+                .expect("inside");
+            assert_eq!(st, fresh);
+        }
         let mesh = mesh();
         let umls = Umls2::new(mesh.clone());
         let fe = LinearFeKernel::new(mesh);
@@ -551,21 +570,8 @@ mod tests {
             SVector::from([0.52, 0.18]),
         );
         for target in [b, c] {
-            let (mut st, mut fresh) = (Stencil::new(), Stencil::new());
-            let mut cache = HostCache::default();
-            umls.stencil(&a, &mut cache, &mut st).expect("inside");
-            assert!(umls.domain_exit(&b, &mut cache).is_none());
-            umls.stencil(&target, &mut cache, &mut st).expect("inside");
-            umls.stencil(&target, &mut HostCache::default(), &mut fresh)
-                .expect("inside");
-            assert_eq!(st, fresh);
-            let mut cache = HostCache::default();
-            fe.stencil(&a, &mut cache, &mut st).expect("inside");
-            assert!(fe.domain_exit(&b, &mut cache).is_none());
-            fe.stencil(&target, &mut cache, &mut st).expect("inside");
-            fe.stencil(&target, &mut HostCache::default(), &mut fresh)
-                .expect("inside");
-            assert_eq!(st, fresh);
+            check(&umls, a, b, target);
+            check(&fe, a, b, target);
         }
     }
 }
