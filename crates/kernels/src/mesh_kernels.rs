@@ -475,8 +475,10 @@ impl<const D: usize> Kernel<D> for LinearFeKernel<D> {
         cache: &mut HostCache<D>,
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError> {
-        let host = locate(&self.mesh, x, cache)? as usize;
-        let lambda = self.mesh.barycentric(host, x);
+        // The location's coordinates are `barycentric(host, x)` itself (every locating
+        // path computes them so), so they are not computed again.
+        let located = locate_with_coordinates(&self.mesh, x, cache)?;
+        let (host, lambda) = (located.simplex as usize, located.barycentric);
         let gradients = self.mesh.barycentric_gradients(host);
         out.clear();
         for ((&v, &l), g) in self
