@@ -117,6 +117,14 @@ impl<'a, const D: usize> ParticleStencil<'a, D> {
         self.nodes.len()
     }
 
+    /// The smallest and largest node, (0, 0) for an empty stencil (as
+    /// [`Stencil::node_range`] reads them).
+    fn node_range(&self) -> (u32, u32) {
+        let lo = self.nodes.iter().copied().min();
+        let hi = self.nodes.iter().copied().max();
+        lo.zip(hi).unwrap_or((0, 0))
+    }
+
     /// x_i − x_p for entry `e` of the particle at `x`.
     #[inline]
     pub fn offset<K: Kernel<D>>(
@@ -258,22 +266,26 @@ impl<const D: usize> Stencils<D> {
                                     .map_err(fail)?;
                             }
                             Mode::Entries | Mode::EntriesWithMoments => {
-                                kernel.stencil(x, cache, st).map_err(fail)?;
-                                *range = st.node_range().unwrap_or((0, 0));
-                                offsets.push(nodes.len());
-                                nodes.extend_from_slice(st.nodes());
-                                values.extend_from_slice(st.values());
-                                gradients.extend_from_slice(st.gradients());
+                                let start = nodes.len();
+                                kernel
+                                    .append_stencil(x, cache, st, nodes, values, gradients)
+                                    .map_err(fail)?;
+                                offsets.push(start);
+                                // Read back from the arrays' ends, still in cache; the
+                                // offsets are node_position − x, as P2G and G2P take
+                                // them for stored entries.
+                                let stored = ParticleStencil {
+                                    nodes: &nodes[start..],
+                                    values: &values[start..],
+                                    gradients: &gradients[start..],
+                                    offsets: &[],
+                                };
+                                *range = stored.node_range();
                                 if mode == Mode::EntriesWithMoments {
-                                    moments.push(second_moment(
-                                        &ParticleStencil::of(st),
-                                        kernel,
-                                        x,
-                                    ));
+                                    moments.push(second_moment(&stored, kernel, x));
                                 }
                                 if let Some(xi) = correction {
-                                    correction_means
-                                        .push(correction_mean(&ParticleStencil::of(st), xi));
+                                    correction_means.push(correction_mean(&stored, xi));
                                 }
                             }
                         }
@@ -365,6 +377,37 @@ impl<const D: usize> Stencils<D> {
             .map_err(|e| (p, e))
     }
 
+    /// Whether the stencils are stored as entries ([`Self::visit_entries`] visits them).
+    #[inline]
+    pub fn stores_entries(&self) -> bool {
+        matches!(self.mode, Mode::Entries | Mode::EntriesWithMoments)
+    }
+
+    /// [`Self::visit`] of a stored stencil ([`Self::stores_entries`]): no call takes
+    /// the sink, so a caller that keeps its sums in a sink of its own for this case gets
+    /// them kept in registers (behind [`Self::visit`]'s other modes, whose kernel calls
+    /// take the sink's address, the sums lived in memory).
+    #[inline(always)]
+    pub fn visit_entries<K: Kernel<D>, S: EntrySink<D>>(
+        &self,
+        p: usize,
+        kernel: &K,
+        x: &SVector<f64, D>,
+        offsets: bool,
+        sink: &mut S,
+    ) {
+        let (chunk, _, range) = self.stored_entries(p);
+        for e in range {
+            let node = chunk.nodes[e];
+            let offset = if offsets {
+                kernel.node_position(node as usize) - x
+            } else {
+                SVector::zeros()
+            };
+            sink.entry(node, chunk.values[e], &chunk.gradients[e], &offset);
+        }
+    }
+
     /// Hands every entry of particle `p`'s stencil to `sink`: the stored one, rebuilt
     /// from its factors, or the kernel's [`Kernel::visit_stencil`] at `x` from `cache`
     /// (same entries, same bits, and for a closed-form kernel no arrays written and read
@@ -384,16 +427,7 @@ impl<const D: usize> Stencils<D> {
     ) -> Result<(), (usize, KernelError)> {
         match self.mode {
             Mode::Entries | Mode::EntriesWithMoments => {
-                let (chunk, _, range) = self.stored_entries(p);
-                for e in range {
-                    let node = chunk.nodes[e];
-                    let offset = if offsets {
-                        kernel.node_position(node as usize) - x
-                    } else {
-                        SVector::zeros()
-                    };
-                    sink.entry(node, chunk.values[e], &chunk.gradients[e], &offset);
-                }
+                self.visit_entries(p, kernel, x, offsets, sink);
                 Ok(())
             }
             Mode::Factored(layout) => {

@@ -18,6 +18,8 @@ macro_rules! mesh_nodes {
             self.mesh.vertex_count()
         }
 
+        // Inlined: the transfers of stored entries take each entry's offset from it.
+        #[inline]
         fn node_position(&self, node: usize) -> SVector<f64, D> {
             *self.mesh.vertex(node)
         }
@@ -353,6 +355,46 @@ where
         let entries = out.entries_mut(out.len());
         for (offset, &v) in entries.offsets.iter_mut().zip(entries.nodes.iter()) {
             *offset = self.mesh.vertex(v as usize) - x;
+        }
+        Ok(())
+    }
+
+    /// The fit written straight onto the ends of the engine's arrays: no stencil in
+    /// between to copy from, and no offsets, which stored entries do not keep (a copy and
+    /// the offsets were a tenth of the stencil stage on the 3D column).
+    fn append_stencil(
+        &self,
+        x: &SVector<f64, D>,
+        cache: &mut HostCache<D>,
+        _scratch: &mut Stencil<D>,
+        nodes: &mut Vec<u32>,
+        values: &mut Vec<f64>,
+        gradients: &mut Vec<SVector<f64, D>>,
+    ) -> Result<(), KernelError> {
+        let located = locate_with_coordinates(&self.mesh, x, cache)?;
+        let ring = self
+            .mesh
+            .topology()
+            .one_ring(located.simplex as usize)
+            .len();
+        let start = nodes.len();
+        nodes.resize(start + ring, 0);
+        values.resize(start + ring, 0.0);
+        gradients.resize(start + ring, SVector::zeros());
+        let evaluated = self.kernel.evaluate_into::<N, B>(
+            &self.mesh,
+            &located,
+            x,
+            self.gradient,
+            &mut nodes[start..],
+            &mut values[start..],
+            &mut gradients[start..],
+        );
+        if let Err(e) = evaluated {
+            nodes.truncate(start);
+            values.truncate(start);
+            gradients.truncate(start);
+            return Err(KernelError::evaluation("UMLS", e));
         }
         Ok(())
     }

@@ -14,7 +14,9 @@
 //!   `Kernel::domain_exit` (which an engine calls with a particle's new position) has
 //!   first left in the warm cache what it found at the point, and no domain exit for a
 //!   point inside the domain;
-//! - `Kernel::visit_stencil` handing over the stencil's entries in order, bit for bit;
+//! - `Kernel::visit_stencil` handing over the stencil's entries in order, bit for bit,
+//!   and `Kernel::append_stencil` appending them after what its arrays held (and
+//!   leaving the arrays as they were where it fails);
 //! - factored stencils (`Kernel::factor_layout`) of the declared layout, rebuilt by
 //!   `Kernel::visit_factored` into the stencil's entries, with its node range; and
 //!   `KernelError::NotFactored` from a kernel without a layout;
@@ -152,6 +154,7 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
                 "visit_stencil hands over other entries than stencil gives".into(),
             ));
         }
+        check_appended(kernel, x, &st).map_err(fail)?;
         check_factors(kernel, x, &st).map_err(fail)?;
     }
     let outside_error = |what: &str, got: String| Violation {
@@ -167,8 +170,64 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
         other => return Err(outside_error("node_range", format!("{other:?}"))),
     }
     match kernel.visit_stencil(&outside, &mut K::Cache::default(), &mut st, |_, _, _, _| {}) {
-        Err(KernelError::OutsideDomain { .. }) => Ok(()),
-        other => Err(outside_error("visit_stencil", format!("{other:?}"))),
+        Err(KernelError::OutsideDomain { .. }) => {}
+        other => return Err(outside_error("visit_stencil", format!("{other:?}"))),
+    }
+    // A failed append leaves what the arrays held.
+    let (mut nodes, mut values, mut gradients): (Vec<u32>, Vec<f64>, Vec<SVector<f64, D>>) =
+        (vec![7], vec![0.5], vec![SVector::repeat(2.0)]);
+    match kernel.append_stencil(
+        &outside,
+        &mut K::Cache::default(),
+        &mut st,
+        &mut nodes,
+        &mut values,
+        &mut gradients,
+    ) {
+        Err(KernelError::OutsideDomain { .. }) => {}
+        other => return Err(outside_error("append_stencil", format!("{other:?}"))),
+    }
+    if nodes != [7] || values != [0.5] || gradients[..] != [SVector::<f64, D>::repeat(2.0)] {
+        return Err(outside_error(
+            "append_stencil",
+            "an error that left entries in the arrays".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// `Kernel::append_stencil` at `x`, whose stencil is `st`: the stencil's nodes, values
+/// and gradients, bit for bit, after what the arrays held.
+fn check_appended<const D: usize, K: Kernel<D>>(
+    kernel: &K,
+    x: &SVector<f64, D>,
+    st: &Stencil<D>,
+) -> Result<(), String> {
+    let (mut nodes, mut values, mut gradients): (Vec<u32>, Vec<f64>, Vec<SVector<f64, D>>) =
+        (vec![7], vec![0.5], vec![SVector::repeat(2.0)]);
+    kernel
+        .append_stencil(
+            x,
+            &mut K::Cache::default(),
+            &mut Stencil::new(),
+            &mut nodes,
+            &mut values,
+            &mut gradients,
+        )
+        .map_err(|e| format!("append_stencil fails inside the domain: {e}"))?;
+    let same = nodes[0] == 7
+        && values[0] == 0.5
+        && gradients[0] == SVector::<f64, D>::repeat(2.0)
+        && nodes[1..] == *st.nodes()
+        && values[1..]
+            .iter()
+            .map(|v| v.to_bits())
+            .eq(st.values().iter().map(|v| v.to_bits()))
+        && gradients[1..] == *st.gradients();
+    if same {
+        Ok(())
+    } else {
+        Err("append_stencil appends other entries than stencil gives".into())
     }
 }
 

@@ -161,6 +161,29 @@ pub trait Kernel<const D: usize>: Send + Sync {
         out: &mut Stencil<D>,
     ) -> Result<(), KernelError>;
 
+    /// Appends the stencil at `x` to `nodes`, `values` and `gradients`, with the entries,
+    /// order and bits of [`Self::stencil`], and without its offsets (an engine that stores
+    /// stencils recovers them as [`Self::node_position`] − x). On failure the three
+    /// vectors are left as they were. The default evaluates [`Self::stencil`] into
+    /// `scratch` and copies it; a kernel that can write its entries in place (an MLS fit
+    /// of known length) overrides it to save the copy and the offsets.
+    #[inline]
+    fn append_stencil(
+        &self,
+        x: &SVector<f64, D>,
+        cache: &mut Self::Cache,
+        scratch: &mut Stencil<D>,
+        nodes: &mut Vec<u32>,
+        values: &mut Vec<f64>,
+        gradients: &mut Vec<SVector<f64, D>>,
+    ) -> Result<(), KernelError> {
+        self.stencil(x, cache, scratch)?;
+        nodes.extend_from_slice(scratch.nodes());
+        values.extend_from_slice(scratch.values());
+        gradients.extend_from_slice(scratch.gradients());
+        Ok(())
+    }
+
     /// Calls `visit(node, N, ∇N, x_node − x)` for every entry of the stencil at `x`, in
     /// the order and with the values [`Self::stencil`] gives, bit for bit, and fails
     /// where it fails. The default evaluates [`Self::stencil`] into `scratch` and walks

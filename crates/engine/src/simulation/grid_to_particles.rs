@@ -87,7 +87,7 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
     let moment_scale = kernel.constant_second_moment();
     let offsets = T::AFFINE && (T::USES_MOMENTS || moment_scale.is_none());
     let stored_moment = stencils.stored_second_moment(p);
-    let mut sums = GatherSums::<D, T> {
+    let new_sums = || GatherSums::<D, T> {
         grid,
         sum_moment: moment_scale.is_none() && stored_moment.is_none(),
         offsets,
@@ -102,7 +102,18 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
         },
         transfer: std::marker::PhantomData,
     };
-    stencils.visit(p, kernel, &x, cache, scratch, offsets, &mut sums)?;
+    // Stored entries get sums of their own, which no kernel call takes: they stay in
+    // registers (through `visit`, whose other modes pass the sink to the kernel, they
+    // were reloaded from memory at every entry).
+    let sums = if stencils.stores_entries() {
+        let mut sums = new_sums();
+        stencils.visit_entries(p, kernel, &x, offsets, &mut sums);
+        sums
+    } else {
+        let mut sums = new_sums();
+        stencils.visit(p, kernel, &x, cache, scratch, offsets, &mut sums)?;
+        sums
+    };
     let GatherSums {
         pic,
         flip,
