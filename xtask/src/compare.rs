@@ -41,9 +41,9 @@ const DEFAULT_CASES: [&str; 6] = [
     "fluid-box-3d --end-time 0.01",
     // The same with MLS-MPM, the transfer of the side-by-side measurement.
     "fluid-box-3d --set transfer.kind=mls-mpm --end-time 0.02",
-    // The same with UMLS on the 1.57 M-tetrahedron lattice, where the step is bound by
-    // memory (20 steps; the mesh and the integration correction take about 8 s on one
-    // thread before them, untimed).
+    // The same with UMLS on the 1.57 M-tetrahedron lattice, where memory adds about a
+    // quarter to the step (20 steps; the mesh and the integration correction take about
+    // 8 s on one thread before them, untimed).
     "fluid-box-3d --kernel umls --end-time 0.004",
     // UMLS in 3D on the Kuhn lattice with its integration correction.
     "hydrostatic-column-3d --kernel umls --end-time 0.1",
