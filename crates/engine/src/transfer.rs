@@ -141,6 +141,9 @@ impl TransferScheme for Apic {
     fn name(&self) -> &'static str {
         "APIC"
     }
+    // Inlined: called with G2P's sums, which a call would keep in memory through the
+    // stencil's loop.
+    #[inline]
     fn affine<const D: usize>(
         &self,
         b: &SMatrix<f64, D, D>,
