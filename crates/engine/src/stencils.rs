@@ -7,7 +7,7 @@
 
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
-use umls_transfer::{FactorLayout, Kernel, KernelError, Stencil};
+use umls_transfer::{FactorLayout, Kernel, KernelError, Stencil, node_range};
 
 use crate::parallel::lowest_failure;
 use crate::settings::StencilStorage;
@@ -115,14 +115,6 @@ impl<'a, const D: usize> ParticleStencil<'a, D> {
     #[inline]
     pub fn len(&self) -> usize {
         self.nodes.len()
-    }
-
-    /// The smallest and largest node, (0, 0) for an empty stencil (as
-    /// [`Stencil::node_range`] reads them).
-    fn node_range(&self) -> (u32, u32) {
-        let lo = self.nodes.iter().copied().min();
-        let hi = self.nodes.iter().copied().max();
-        lo.zip(hi).unwrap_or((0, 0))
     }
 
     /// x_i − x_p for entry `e` of the particle at `x`.
@@ -280,7 +272,7 @@ impl<const D: usize> Stencils<D> {
                                     gradients: &gradients[start..],
                                     offsets: &[],
                                 };
-                                *range = stored.node_range();
+                                *range = node_range(stored.nodes).unwrap_or((0, 0));
                                 if mode == Mode::EntriesWithMoments {
                                     moments.push(second_moment(&stored, kernel, x));
                                 }

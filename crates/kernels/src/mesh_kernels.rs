@@ -312,26 +312,48 @@ impl<const D: usize, const N: usize, B, W: WeightFunction> UmlsMeshKernel<D, N, 
         B: PolynomialBasis<D, N>,
     {
         // Written in place: no fixed-capacity stencil between the fit and `out`.
-        let ring = self
-            .mesh
+        let entries = out.entries_mut(self.ring_len(located));
+        let evaluated =
+            self.fit_slices(located, x, entries.nodes, entries.values, entries.gradients);
+        if evaluated.is_err() {
+            out.clear();
+        }
+        evaluated
+    }
+
+    /// The size of the 1-ring of `located`'s host: the length of its stencil.
+    fn ring_len(&self, located: &Located<D>) -> usize {
+        self.mesh
             .topology()
             .one_ring(located.simplex as usize)
-            .len();
-        let entries = out.entries_mut(ring);
-        let evaluated = self.kernel.evaluate_into::<N, B>(
-            &self.mesh,
-            located,
-            x,
-            self.gradient,
-            entries.nodes,
-            entries.values,
-            entries.gradients,
-        );
-        if let Err(e) = evaluated {
-            out.clear();
-            return Err(KernelError::evaluation("UMLS", e));
-        }
-        Ok(())
+            .len()
+    }
+
+    /// The fit at `x` written into slices of the ring's length ([`Self::ring_len`]),
+    /// with the fit's error as the port's.
+    fn fit_slices(
+        &self,
+        located: &Located<D>,
+        x: &SVector<f64, D>,
+        nodes: &mut [u32],
+        values: &mut [f64],
+        gradients: &mut [SVector<f64, D>],
+    ) -> Result<(), KernelError>
+    where
+        B: PolynomialBasis<D, N>,
+    {
+        self.kernel
+            .evaluate_into::<N, B>(
+                &self.mesh,
+                located,
+                x,
+                self.gradient,
+                nodes,
+                values,
+                gradients,
+            )
+            .map(|_| ())
+            .map_err(|e| KernelError::evaluation("UMLS", e))
     }
 }
 
@@ -372,31 +394,23 @@ where
         gradients: &mut Vec<SVector<f64, D>>,
     ) -> Result<(), KernelError> {
         let located = locate_with_coordinates(&self.mesh, x, cache)?;
-        let ring = self
-            .mesh
-            .topology()
-            .one_ring(located.simplex as usize)
-            .len();
-        let start = nodes.len();
-        nodes.resize(start + ring, 0);
-        values.resize(start + ring, 0.0);
-        gradients.resize(start + ring, SVector::zeros());
-        let evaluated = self.kernel.evaluate_into::<N, B>(
-            &self.mesh,
+        let (start, end) = (nodes.len(), nodes.len() + self.ring_len(&located));
+        nodes.resize(end, 0);
+        values.resize(end, 0.0);
+        gradients.resize(end, SVector::zeros());
+        let evaluated = self.fit_slices(
             &located,
             x,
-            self.gradient,
             &mut nodes[start..],
             &mut values[start..],
             &mut gradients[start..],
         );
-        if let Err(e) = evaluated {
+        if evaluated.is_err() {
             nodes.truncate(start);
             values.truncate(start);
             gradients.truncate(start);
-            return Err(KernelError::evaluation("UMLS", e));
         }
-        Ok(())
+        evaluated
     }
 
     /// The host's 1-ring's smallest and largest vertex, without the fit: the engine's

@@ -174,8 +174,7 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
         other => return Err(outside_error("visit_stencil", format!("{other:?}"))),
     }
     // A failed append leaves what the arrays held.
-    let (mut nodes, mut values, mut gradients): (Vec<u32>, Vec<f64>, Vec<SVector<f64, D>>) =
-        (vec![7], vec![0.5], vec![SVector::repeat(2.0)]);
+    let (mut nodes, mut values, mut gradients) = held::<D>();
     match kernel.append_stencil(
         &outside,
         &mut K::Cache::default(),
@@ -187,13 +186,19 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
         Err(KernelError::OutsideDomain { .. }) => {}
         other => return Err(outside_error("append_stencil", format!("{other:?}"))),
     }
-    if nodes != [7] || values != [0.5] || gradients[..] != [SVector::<f64, D>::repeat(2.0)] {
+    if (nodes, values, gradients) != held::<D>() {
         return Err(outside_error(
             "append_stencil",
             "an error that left entries in the arrays".into(),
         ));
     }
     Ok(())
+}
+
+/// What the arrays hold before `Kernel::append_stencil` is called on them: one entry
+/// that an append must keep in front of its own, and that a failed append must leave.
+fn held<const D: usize>() -> (Vec<u32>, Vec<f64>, Vec<SVector<f64, D>>) {
+    (vec![7], vec![0.5], vec![SVector::repeat(2.0)])
 }
 
 /// `Kernel::append_stencil` at `x`, whose stencil is `st`: the stencil's nodes, values
@@ -203,8 +208,7 @@ fn check_appended<const D: usize, K: Kernel<D>>(
     x: &SVector<f64, D>,
     st: &Stencil<D>,
 ) -> Result<(), String> {
-    let (mut nodes, mut values, mut gradients): (Vec<u32>, Vec<f64>, Vec<SVector<f64, D>>) =
-        (vec![7], vec![0.5], vec![SVector::repeat(2.0)]);
+    let (mut nodes, mut values, mut gradients) = held::<D>();
     kernel
         .append_stencil(
             x,
@@ -215,9 +219,10 @@ fn check_appended<const D: usize, K: Kernel<D>>(
             &mut gradients,
         )
         .map_err(|e| format!("append_stencil fails inside the domain: {e}"))?;
-    let same = nodes[0] == 7
-        && values[0] == 0.5
-        && gradients[0] == SVector::<f64, D>::repeat(2.0)
+    let (held_nodes, held_values, held_gradients) = held::<D>();
+    let same = nodes[..1] == held_nodes
+        && values[..1] == held_values
+        && gradients[..1] == held_gradients
         && nodes[1..] == *st.nodes()
         && values[1..]
             .iter()

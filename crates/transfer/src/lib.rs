@@ -39,7 +39,7 @@ use std::sync::Arc;
 use nalgebra::SVector;
 use thiserror::Error;
 
-pub use stencil::{EntriesMut, Stencil};
+pub use stencil::{EntriesMut, Stencil, node_range};
 
 /// Why a kernel could not produce a stencil.
 #[derive(Debug, Clone, Error)]

@@ -114,9 +114,7 @@ impl<const D: usize> Stencil<D> {
 
     /// The smallest and largest node index (`None` when empty).
     pub fn node_range(&self) -> Option<(u32, u32)> {
-        let lo = self.nodes.iter().copied().min()?;
-        let hi = self.nodes.iter().copied().max()?;
-        Some((lo, hi))
+        node_range(&self.nodes)
     }
 
     /// Iterator over (node, N_i, ∇N_i).
@@ -141,6 +139,14 @@ pub struct EntriesMut<'a, const D: usize> {
     pub gradients: &'a mut [SVector<f64, D>],
     /// Node offsets x_i − x_p.
     pub offsets: &'a mut [SVector<f64, D>],
+}
+
+/// The smallest and largest of a stencil's `nodes` (`None` when empty): what
+/// [`Stencil::node_range`] gives, for nodes an engine keeps in arrays of its own.
+pub fn node_range(nodes: &[u32]) -> Option<(u32, u32)> {
+    let lo = nodes.iter().copied().min()?;
+    let hi = nodes.iter().copied().max()?;
+    Some((lo, hi))
 }
 
 #[cfg(test)]
