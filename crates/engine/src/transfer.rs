@@ -161,6 +161,7 @@ impl TransferScheme for Apic {
         b * cholesky.inverse()
     }
 
+    #[inline]
     fn affine_with_constant_moment<const D: usize>(
         &self,
         b: &SMatrix<f64, D, D>,
@@ -176,6 +177,7 @@ impl TransferScheme for Apic {
 /// scheme that shares APIC's affine field.
 macro_rules! apic_affine {
     () => {
+        #[inline]
         fn affine<const D: usize>(
             &self,
             b: &SMatrix<f64, D, D>,
@@ -184,6 +186,7 @@ macro_rules! apic_affine {
         ) -> SMatrix<f64, D, D> {
             Apic.affine(b, d, grad_v)
         }
+        #[inline]
         fn affine_with_constant_moment<const D: usize>(
             &self,
             b: &SMatrix<f64, D, D>,
