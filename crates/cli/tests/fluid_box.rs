@@ -54,13 +54,9 @@ fn fluid_box_falls_freely_at_first_without_a_mesh() {
 /// bitwise unchanged by the thread count.
 #[test]
 fn fluid_box_falls_freely_under_mls_mpm_on_any_thread_count() {
-    let scene = runs::variant(
-        "fluid-box-3d",
-        &[
-            ("kind = \"apic\"", "kind = \"mls-mpm\""),
-            ("frames = 26", "frames = 2"),
-        ],
-    );
+    let mut edits = few_frames().to_vec();
+    edits.push(("transfer.kind".into(), "\"mls-mpm\"".into()));
+    let scene = Scene::load_with("fluid-box-3d", &edits).unwrap();
     let mut histories = Vec::new();
     for threads in [1, 2] {
         let mut options = options(&format!("fluid-box-mls-mpm-{threads}"), None, Some(0.005));
@@ -127,8 +123,10 @@ fn factored_umls_stencils_give_the_stored_run_in_less_memory() {
                 // Thrown at the floor and a wall: particles cross faces and hit walls.
                 ("bodies.velocity".into(), "[2.0, -3.0, 1.0]".into()),
                 ("output.history_every".into(), "1".into()),
-                ("output.frames".into(), "2".into()),
-            ],
+            ]
+            .into_iter()
+            .chain(few_frames())
+            .collect::<Vec<_>>(),
         )
         .unwrap();
         let options = options(
