@@ -9,10 +9,11 @@ use umls_cli::setup::{build, build_for, tetrahedra, triangles};
 mod runs;
 use runs::{History, options};
 
-/// The first and last particle frames only: 64,000 particles take 22 MB a frame, and
-/// these tests read the history, not the frames.
-fn few_frames() -> [(String, String); 1] {
-    [("output.frames".into(), "2".into())]
+/// `edits` and the first and last particle frames only: 64,000 particles take 22 MB a
+/// frame, and these tests read the history, not the frames.
+fn with_few_frames(mut edits: Vec<(String, String)>) -> Vec<(String, String)> {
+    edits.push(("output.frames".into(), "2".into()));
+    edits
 }
 
 /// The first 25 steps: the block is in free fall (it is 0.1 above the floor plane), so
@@ -20,7 +21,7 @@ fn few_frames() -> [(String, String); 1] {
 /// built or written.
 #[test]
 fn fluid_box_falls_freely_at_first_without_a_mesh() {
-    let scene = Scene::load_with("fluid-box-3d", &few_frames()).unwrap();
+    let scene = Scene::load_with("fluid-box-3d", &with_few_frames(Vec::new())).unwrap();
     let options = options("fluid-box", None, Some(0.005));
     let report = run(&scene, &options).unwrap();
     let out = options.out.clone();
@@ -54,8 +55,7 @@ fn fluid_box_falls_freely_at_first_without_a_mesh() {
 /// bitwise unchanged by the thread count.
 #[test]
 fn fluid_box_falls_freely_under_mls_mpm_on_any_thread_count() {
-    let mut edits = few_frames().to_vec();
-    edits.push(("transfer.kind".into(), "\"mls-mpm\"".into()));
+    let edits = with_few_frames(vec![("transfer.kind".into(), "\"mls-mpm\"".into())]);
     let scene = Scene::load_with("fluid-box-3d", &edits).unwrap();
     let mut histories = Vec::new();
     for threads in [1, 2] {
@@ -116,17 +116,14 @@ fn factored_umls_stencils_give_the_stored_run_in_less_memory() {
     for storage in ["store", "factored"] {
         let scene = Scene::load_with(
             "fluid-box-3d",
-            &[
+            &with_few_frames(vec![
                 ("kernel.stencils".into(), format!("\"{storage}\"")),
                 ("mesh.lattice.cells".into(), "[16, 16, 16]".into()),
                 ("bodies.seeding.lattice".into(), "0.02".into()),
                 // Thrown at the floor and a wall: particles cross faces and hit walls.
                 ("bodies.velocity".into(), "[2.0, -3.0, 1.0]".into()),
                 ("output.history_every".into(), "1".into()),
-            ]
-            .into_iter()
-            .chain(few_frames())
-            .collect::<Vec<_>>(),
+            ]),
         )
         .unwrap();
         let options = options(
