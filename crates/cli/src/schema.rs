@@ -162,8 +162,9 @@ pub enum KernelKind {
     /// C¹ UMLS kernel on the mesh: linear basis, cubic B-spline weights with the
     /// incident-edge support radius, and the integration correction of its force
     /// gradients (docs/umls-kernel.md has the studies that chose them). The other UMLS
-    /// names change one part of `umls-uncorrected`, the kernel their studies measured
-    /// against; `[kernel] integration_correction = true` corrects any of them.
+    /// names but `umls-eta-power` (which varies `umls` itself) change one part of
+    /// `umls-uncorrected`, the kernel their studies measured against; `[kernel]
+    /// integration_correction = true` corrects any of them.
     #[default]
     Umls,
     /// UMLS with the quadratic basis on the 1-ring (ridge on the quadratic terms).
@@ -189,6 +190,11 @@ pub enum KernelKind {
     /// The `umls` kernel without the integration correction of its force gradients: the
     /// default before the correction (docs/umls-kernel.md, *Integration correction*).
     UmlsUncorrected,
+    /// The `umls` kernel (integration correction included) with weights η⁴ · d and the
+    /// incident-edge support factor 1.4: the diminishing factor raised to a power narrows
+    /// the stencil onto the host's vertices, the wider distance weight keeps it smooth
+    /// (docs/umls-kernel.md, *Powered diminishing factor*).
+    UmlsEtaPower,
     /// Linear finite-element shape functions on the mesh.
     LinearFe,
     /// Quadratic B-splines on a Cartesian grid covering the mesh.
@@ -210,6 +216,7 @@ impl KernelKind {
             KernelKind::UmlsFullGradient => "umls-full-gradient",
             KernelKind::UmlsFrozenEta => "umls-frozen-eta",
             KernelKind::UmlsUncorrected => "umls-uncorrected",
+            KernelKind::UmlsEtaPower => "umls-eta-power",
             KernelKind::LinearFe => "linear-fe",
             KernelKind::Bspline2 => "bspline2",
             KernelKind::Bspline3 => "bspline3",
@@ -238,6 +245,9 @@ pub struct KernelSpec {
     pub support_factor: Option<f64>,
     /// UMLS kernels: which shape-function gradient (default: the kernel name's).
     pub gradient: Option<GradientSpec>,
+    /// UMLS kernels: the exponent p ≥ 1 of the weights η^p · d (default: the kernel
+    /// name's; 1 for every name but `umls-eta-power`, 4).
+    pub diminishing_exponent: Option<u32>,
     /// UMLS kernels: whether the force's gradients are corrected node by node to
     /// integrate like the fit's full derivative (default: the kernel name's; `umls`
     /// corrects, the other names do not). Kernels whose gradient is their derivative
@@ -307,6 +317,7 @@ impl KernelKind {
                 | KernelKind::UmlsFullGradient
                 | KernelKind::UmlsFrozenEta
                 | KernelKind::UmlsUncorrected
+                | KernelKind::UmlsEtaPower
         )
     }
 }

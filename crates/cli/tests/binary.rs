@@ -218,6 +218,7 @@ fn kernel_override_and_conservation() {
         "umls-full-gradient",
         "umls-frozen-eta",
         "umls-uncorrected",
+        "umls-eta-power",
     ] {
         let dir = scratch(&format!("disks-{kernel}"));
         let out = umls(&[

@@ -10,7 +10,9 @@ use umls_kernels::testing::check_kernel;
 use umls_kernels::{
     BSplineKernel, BSplineOrder, GradientKind, LinearFeKernel, Umls1, Umls2, Umls3,
 };
+use umls_mesh::SimplexMesh;
 use umls_mesh::generate::{Diagonal, Lattice};
+use umls_mls::{CubicBSpline, SupportRadius, UmlsKernel};
 use umls_transfer::{Kernel, Stencil};
 
 /// Runs the public suite (`umls_kernels::testing`) on points given as fractions of the
@@ -27,6 +29,18 @@ fn conformance<const D: usize, K: Kernel<D>>(
         .collect();
     let outside = hi + SVector::<f64, D>::repeat(10.0 * kernel.spacing() + 1.0);
     check_kernel(kernel, &points, outside).map_err(|v| TestCaseError::fail(v.to_string()))
+}
+
+/// The MLS settings of the CLI's `umls-eta-power`: weights η⁴ · d with the incident-edge
+/// support factor 1.4.
+fn powered<const D: usize>(mesh: &SimplexMesh<D>) -> UmlsKernel<D> {
+    UmlsKernel::with_weight(
+        mesh,
+        CubicBSpline,
+        SupportRadius::IncidentEdge { factor: 1.4 },
+    )
+    .and_then(|k| k.with_diminishing_exponent(4))
+    .unwrap()
 }
 
 fn fractions(d: usize) -> impl Strategy<Value = Vec<f64>> {
@@ -55,6 +69,7 @@ proptest! {
         conformance(&Umls2::new(mesh.clone()), lo, hi, &f)?;
         conformance(&Umls2::new(mesh.clone()).with_gradient(GradientKind::Full), lo, hi, &f)?;
         conformance(&Umls2::new(mesh.clone()).with_gradient(GradientKind::FrozenEta), lo, hi, &f)?;
+        conformance(&Umls2::with_kernel(mesh.clone(), powered(&mesh)), lo, hi, &f)?;
         conformance(&LinearFeKernel::new(mesh), lo, hi, &f)?;
         // Same points mapped into the rotated square.
         let mapped: Vec<f64> = f.chunks_exact(2).flat_map(|c| {
@@ -73,6 +88,7 @@ proptest! {
         conformance(&Umls3::new(mesh.clone()), lo, hi, &f)?;
         conformance(&Umls3::new(mesh.clone()).with_gradient(GradientKind::Full), lo, hi, &f)?;
         conformance(&Umls3::new(mesh.clone()).with_gradient(GradientKind::FrozenEta), lo, hi, &f)?;
+        conformance(&Umls3::with_kernel(mesh.clone(), powered(&mesh)), lo, hi, &f)?;
         conformance(&LinearFeKernel::new(mesh), lo, hi, &f)?;
     }
 

@@ -14,8 +14,9 @@
 //! With the default `mesh` feature, [`UmlsKernel`] evaluates the UMLS kernel on a
 //! [`umls_mesh::SimplexMesh`]: the samples are the host simplex's 1-ring and the weights
 //! w_v = η_v · d_v combine the [`diminishing_factor`] η_v = Σ_n λ_n A_{v,n} with a radial
-//! weight d_v. Shape functions and reconstructed gradients are continuous across facets
-//! (the tests measure the jumps), unlike linear finite-element shape functions.
+//! weight d_v (or η_v^p · d_v, [`UmlsKernel::with_diminishing_exponent`]). Shape
+//! functions and reconstructed gradients are continuous across facets (the tests measure
+//! the jumps), unlike linear finite-element shape functions.
 //! [`UmlsKernel::evaluate_into`] writes the same values straight into a caller's arrays
 //! of any length (an MPM engine's stencil storage), with no intermediate stencil;
 //! [`UmlsKernel::fit_into`] keeps the fit as its weights and a [`UmlsFit`] (M⁻¹ and the
@@ -55,7 +56,9 @@ mod umls_fit;
 mod weight;
 
 pub use basis::{Linear, PolynomialBasis, Quadratic};
-pub use diminishing::{diminishing_factor, diminishing_gradient};
+pub use diminishing::{
+    diminishing_factor, diminishing_gradient, powered_diminishing, powered_diminishing_slope,
+};
 pub use error::MlsError;
 pub use point_cloud::PointCloudMls;
 pub use solve::{Conditioning, IllConditionedPolicy, Samples, shape_functions};

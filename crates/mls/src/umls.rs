@@ -5,7 +5,9 @@ use nalgebra::SVector;
 use umls_mesh::{Barycentric, INSIDE_TOLERANCE, Located, SimplexMesh};
 
 use crate::basis::PolynomialBasis;
-use crate::diminishing::{diminishing_factor, diminishing_gradient};
+use crate::diminishing::{
+    diminishing_factor, diminishing_gradient, powered_diminishing, powered_diminishing_slope,
+};
 use crate::error::MlsError;
 use crate::point_cloud::radial_weight;
 use crate::solve::{
@@ -73,6 +75,8 @@ pub const HOST_TOLERANCE: f64 = 1e3 * INSIDE_TOLERANCE;
 pub struct UmlsKernel<const D: usize, W: WeightFunction = CubicBSpline> {
     radii: Vec<f64>,
     weight: W,
+    /// p of the weights η^p · d (1: the paper's η · d).
+    diminishing_exponent: u32,
     /// Conditioning limit and policy of the moment matrix.
     pub conditioning: Conditioning,
 }
@@ -141,8 +145,36 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
         Ok(Self {
             radii,
             weight,
+            diminishing_exponent: 1,
             conditioning: Conditioning::default(),
         })
+    }
+
+    /// The same kernel with weights w_v = η_v^p · d_v instead of η_v · d_v
+    /// ([`crate::powered_diminishing`]): p = 1 is the paper's kernel. Value and
+    /// reconstructed gradient stay continuous and linear fields stay reproduced for any
+    /// p ≥ 1 (the weights stay continuous, and vanish where a vertex leaves the ring);
+    /// larger p narrows the stencil onto the host's vertices (docs/umls-kernel.md,
+    /// *Powered diminishing factor*).
+    ///
+    /// # Errors
+    /// [`MlsError::InvalidParameter`] for p = 0, which would weight every ring vertex
+    /// alike and make the weights jump across facets.
+    pub fn with_diminishing_exponent(mut self, exponent: u32) -> Result<Self, MlsError> {
+        if exponent == 0 {
+            return Err(MlsError::InvalidParameter {
+                parameter: "diminishing exponent",
+                value: 0.0,
+                reason: "must be at least 1 (0 makes the weights jump across facets)",
+            });
+        }
+        self.diminishing_exponent = exponent;
+        Ok(self)
+    }
+
+    /// p of the weights η^p · d.
+    pub fn diminishing_exponent(&self) -> u32 {
+        self.diminishing_exponent
     }
 
     /// Support radius h_v of every vertex.
@@ -204,13 +236,19 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
             let xv = mesh.vertex(v as usize);
             let h = self.radii[v as usize];
             let (d, dd) = radial_weight(&self.weight, x, xv, h);
-            let eta = diminishing_factor(mask, lambda.as_slice());
+            let p = self.diminishing_exponent;
+            let linear = diminishing_factor(mask, lambda.as_slice());
+            let eta = powered_diminishing(linear, p);
             positions[i] = *xv;
             weights[i] = eta * d;
             weight_gradients[i] = match gradient {
                 // η frozen at x: only the distance weight varies.
                 GradientKind::FrozenEta => dd * eta,
-                _ => diminishing_gradient(mask, lambda_gradients.as_slice()) * d + dd * eta,
+                _ => {
+                    diminishing_gradient(mask, lambda_gradients.as_slice())
+                        * (d * powered_diminishing_slope(linear, p))
+                        + dd * eta
+                }
             };
         }
         let samples = Samples {
@@ -384,16 +422,47 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
             *offset = mesh.vertex(v as usize) - x;
             *radius = self.radii[v as usize];
         }
-        for ((weight, xi), &mask) in weights
-            .iter_mut()
-            .zip(scaled_offsets.iter_mut())
-            .zip(ring.masks)
-        {
-            let (d, _) = self.weight.evaluate(xi.norm() / *weight);
-            *weight = diminishing_factor(mask, lambda.as_slice()) * d;
-            *xi *= inv_scale;
+        // The exponent is chosen outside the loop, so the paper's η · d keeps its loop
+        // free of the power's branch.
+        match self.diminishing_exponent {
+            1 => self.weigh_ring(
+                ring.masks,
+                lambda,
+                weights,
+                scaled_offsets,
+                inv_scale,
+                |eta| eta,
+            ),
+            p => self.weigh_ring(
+                ring.masks,
+                lambda,
+                weights,
+                scaled_offsets,
+                inv_scale,
+                |eta| powered_diminishing(eta, p),
+            ),
         }
         Ok(inv_scale)
+    }
+
+    /// The arithmetic pass of [`Self::ring_weights`]: `weights` holds the radii and
+    /// `scaled_offsets` the offsets x_v − x on entry, the weights power(η_v) d_v and the
+    /// offsets times `inv_scale` on return.
+    #[inline(always)]
+    fn weigh_ring(
+        &self,
+        masks: &[u8],
+        lambda: &Barycentric<D>,
+        weights: &mut [f64],
+        scaled_offsets: &mut [SVector<f64, D>],
+        inv_scale: f64,
+        power: impl Fn(f64) -> f64,
+    ) {
+        for ((weight, xi), &mask) in weights.iter_mut().zip(scaled_offsets.iter_mut()).zip(masks) {
+            let (d, _) = self.weight.evaluate(xi.norm() / *weight);
+            *weight = power(diminishing_factor(mask, lambda.as_slice())) * d;
+            *xi *= inv_scale;
+        }
     }
 
     /// The reconstructed-gradient fit at `x` in factored form: the 1-ring's weights

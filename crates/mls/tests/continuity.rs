@@ -274,17 +274,20 @@ fn every_umls_variant_is_continuous() {
             "wide",
             Profile::CubicBSpline,
             SupportRadius::PerVertex { factor: 1.0 },
+            1,
         ),
         (
             "paper",
             Profile::CubicBSpline,
             SupportRadius::Global { factor: 1.0 },
+            1,
         ),
-        ("wendland", Profile::WendlandC2, SupportRadius::default()),
+        ("wendland", Profile::WendlandC2, SupportRadius::default(), 1),
         (
             "narrow",
             Profile::CubicBSpline,
             SupportRadius::IncidentEdge { factor: 0.6 },
+            1,
         ),
         (
             "sharpened",
@@ -292,6 +295,13 @@ fn every_umls_variant_is_continuous() {
                 epsilon: DEFAULT_SHARPENING,
             }),
             SupportRadius::default(),
+            1,
+        ),
+        (
+            "eta-power",
+            Profile::CubicBSpline,
+            SupportRadius::IncidentEdge { factor: 1.4 },
+            4,
         ),
     ];
     let tets = Lattice::new([0.0; 3], [1.0; 3], [3, 3, 3])
@@ -299,9 +309,12 @@ fn every_umls_variant_is_continuous() {
         .rotate_about([1.0, 1.0, 0.0], 0.4)
         .tetrahedra()
         .unwrap();
-    for (label, profile, support) in variants {
+    for (label, profile, support, exponent) in variants {
         for mesh in meshes_2d() {
-            let k = UmlsKernel::with_weight(&mesh, profile, support).unwrap();
+            let k = UmlsKernel::with_weight(&mesh, profile, support)
+                .unwrap()
+                .with_diminishing_exponent(exponent)
+                .unwrap();
             assert_continuous(
                 &format!("2D {label}"),
                 &survey(
@@ -310,7 +323,10 @@ fn every_umls_variant_is_continuous() {
                 ),
             );
         }
-        let k = UmlsKernel::with_weight(&tets, profile, support).unwrap();
+        let k = UmlsKernel::with_weight(&tets, profile, support)
+            .unwrap()
+            .with_diminishing_exponent(exponent)
+            .unwrap();
         assert_continuous(
             &format!("3D {label}"),
             &survey(

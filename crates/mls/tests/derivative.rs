@@ -19,8 +19,21 @@ fn check_fd<const D: usize, const N: usize, B: PolynomialBasis<D, N>, W: WeightF
     raw: &[f64],
     weight: W,
 ) -> Result<(), TestCaseError> {
-    let kernel =
-        UmlsKernel::with_weight(mesh, weight, SupportRadius::PerVertex { factor: 1.0 }).unwrap();
+    check_fd_powered::<D, N, B, W>(mesh, s, raw, weight, 1)
+}
+
+/// [`check_fd`] with weights η^p · d.
+fn check_fd_powered<const D: usize, const N: usize, B: PolynomialBasis<D, N>, W: WeightFunction>(
+    mesh: &SimplexMesh<D>,
+    s: usize,
+    raw: &[f64],
+    weight: W,
+    exponent: u32,
+) -> Result<(), TestCaseError> {
+    let kernel = UmlsKernel::with_weight(mesh, weight, SupportRadius::PerVertex { factor: 1.0 })
+        .unwrap()
+        .with_diminishing_exponent(exponent)
+        .unwrap();
     // Keep the point well inside so x ± δ stays in the host.
     let raw: Vec<f64> = raw.iter().map(|r| r + 0.5).collect();
     let x = common::point_in(mesh, s, &raw);
@@ -84,6 +97,20 @@ proptest! {
         check_fd::<2, 3, Linear, _>(&mesh, s % mesh.simplex_count(), &raw, CubicBSpline)?;
         let interior = common::interior_simplices(&mesh);
         check_fd::<2, 6, Quadratic, _>(&mesh, interior[s % interior.len()], &raw, WendlandC2)?;
+    }
+
+    /// With η raised to a power (`umls-eta-power`'s 4, and 2 and 3) the full derivative
+    /// carries p η^{p−1} ∇η, checked the same way.
+    #[test]
+    fn full_gradient_with_a_powered_diminishing_factor_matches_fd(
+        mesh in common::rectangle(),
+        cube in common::fine_cuboid(),
+        s in any::<usize>(),
+        p in 2u32..=4,
+        raw in raw_weights(),
+    ) {
+        check_fd_powered::<2, 3, Linear, _>(&mesh, s % mesh.simplex_count(), &raw, CubicBSpline, p)?;
+        check_fd_powered::<3, 4, Linear, _>(&cube, s % cube.simplex_count(), &raw, CubicBSpline, p)?;
     }
 
     #[test]

@@ -11,8 +11,9 @@ use umls_mls::{
     SharpenedBSpline, Stencil, SupportRadius, UmlsKernel,
 };
 
-/// The UMLS variants the CLI names (docs/umls-kernel.md): profile and radius rule.
-const VARIANTS: [(Profile, SupportRadius); 6] = [
+/// The UMLS variants the CLI names (docs/umls-kernel.md): profile and radius rule (the
+/// exponent of η is in [`EXPONENTS`]).
+const VARIANTS: [(Profile, SupportRadius); 7] = [
     (
         Profile::CubicBSpline,
         SupportRadius::IncidentEdge { factor: 0.9 },
@@ -36,7 +37,15 @@ const VARIANTS: [(Profile, SupportRadius); 6] = [
         }),
         SupportRadius::IncidentEdge { factor: 0.9 },
     ),
+    (
+        Profile::CubicBSpline,
+        SupportRadius::IncidentEdge { factor: 1.4 },
+    ),
 ];
+
+/// The exponent p of the weights η^p · d of each of [`VARIANTS`]: 4 for the last,
+/// `umls-eta-power`, 1 for the others.
+const EXPONENTS: [u32; 7] = [1, 1, 1, 1, 1, 1, 4];
 
 /// Σ N_v = 1, Σ ∇N_v = 0, Σ N_v x_v = x, Σ x_v ∇N_vᵀ = I, for the linear basis and the
 /// default kernel.
@@ -215,12 +224,20 @@ proptest! {
         raw in raw_weights(),
     ) {
         let (profile, support) = VARIANTS[v];
-        let k2 = UmlsKernel::with_weight(&mesh, profile, support).unwrap();
+        let k2 = UmlsKernel::with_weight(&mesh, profile, support)
+            .and_then(|k| k.with_diminishing_exponent(EXPONENTS[v]))
+            .unwrap();
         let s2 = s % mesh.simplex_count();
-        check_linear_with::<2, 3, Linear>(&k2, &mesh, s2, &raw, GradientKind::Reconstructed)?;
-        let k3 = UmlsKernel::with_weight(&cube, profile, support).unwrap();
+        for gradient in [GradientKind::Reconstructed, GradientKind::Full, GradientKind::FrozenEta] {
+            check_linear_with::<2, 3, Linear>(&k2, &mesh, s2, &raw, gradient)?;
+        }
+        let k3 = UmlsKernel::with_weight(&cube, profile, support)
+            .and_then(|k| k.with_diminishing_exponent(EXPONENTS[v]))
+            .unwrap();
         let s3 = s % cube.simplex_count();
-        check_linear_with::<3, 4, Linear>(&k3, &cube, s3, &raw, GradientKind::Reconstructed)?;
+        for gradient in [GradientKind::Reconstructed, GradientKind::Full, GradientKind::FrozenEta] {
+            check_linear_with::<3, 4, Linear>(&k3, &cube, s3, &raw, gradient)?;
+        }
         let mut ridge = k2.clone();
         ridge.conditioning.higher_order_ridge = 1e-3;
         check_linear_with::<2, 6, Quadratic>(&ridge, &mesh, s2, &raw, GradientKind::Reconstructed)?;
