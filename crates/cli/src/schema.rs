@@ -162,7 +162,7 @@ pub enum KernelKind {
     /// C¹ UMLS kernel on the mesh: linear basis, cubic B-spline weights with the
     /// incident-edge support radius, and the integration correction of its force
     /// gradients (docs/umls-kernel.md has the studies that chose them). The other UMLS
-    /// names but `umls-eta-power` (which varies `umls` itself) change one part of
+    /// names but `umls-eta4` and `umls-eta8` (which vary `umls` itself) change one part of
     /// `umls-uncorrected`, the kernel their studies measured against; `[kernel]
     /// integration_correction = true` corrects any of them.
     #[default]
@@ -194,7 +194,11 @@ pub enum KernelKind {
     /// incident-edge support factor 1.4: the diminishing factor raised to a power narrows
     /// the stencil onto the host's vertices, the wider distance weight keeps it smooth
     /// (docs/umls-kernel.md, *Powered diminishing factor*).
-    UmlsEtaPower,
+    UmlsEta4,
+    /// The `umls` kernel with weights η⁸ · d and the incident-edge support factor 2.8:
+    /// further along the same frontier, the disks within 5 points of quadratic B-splines,
+    /// the vortex at h/2 twice the default's error (docs/umls-kernel.md).
+    UmlsEta8,
     /// Linear finite-element shape functions on the mesh.
     LinearFe,
     /// Quadratic B-splines on a Cartesian grid covering the mesh.
@@ -216,7 +220,8 @@ impl KernelKind {
             KernelKind::UmlsFullGradient => "umls-full-gradient",
             KernelKind::UmlsFrozenEta => "umls-frozen-eta",
             KernelKind::UmlsUncorrected => "umls-uncorrected",
-            KernelKind::UmlsEtaPower => "umls-eta-power",
+            KernelKind::UmlsEta4 => "umls-eta4",
+            KernelKind::UmlsEta8 => "umls-eta8",
             KernelKind::LinearFe => "linear-fe",
             KernelKind::Bspline2 => "bspline2",
             KernelKind::Bspline3 => "bspline3",
@@ -246,7 +251,7 @@ pub struct KernelSpec {
     /// UMLS kernels: which shape-function gradient (default: the kernel name's).
     pub gradient: Option<GradientSpec>,
     /// UMLS kernels: the exponent p ≥ 1 of the weights η^p · d (default: the kernel
-    /// name's; 1 for every name but `umls-eta-power`, 4).
+    /// name's; 1 for every name but `umls-eta4`, 4, and `umls-eta8`, 8).
     pub diminishing_exponent: Option<u32>,
     /// UMLS kernels: whether the force's gradients are corrected node by node to
     /// integrate like the fit's full derivative (default: the kernel name's; `umls`
@@ -317,7 +322,8 @@ impl KernelKind {
                 | KernelKind::UmlsFullGradient
                 | KernelKind::UmlsFrozenEta
                 | KernelKind::UmlsUncorrected
-                | KernelKind::UmlsEtaPower
+                | KernelKind::UmlsEta4
+                | KernelKind::UmlsEta8
         )
     }
 }

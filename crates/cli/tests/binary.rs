@@ -218,7 +218,8 @@ fn kernel_override_and_conservation() {
         "umls-full-gradient",
         "umls-frozen-eta",
         "umls-uncorrected",
-        "umls-eta-power",
+        "umls-eta4",
+        "umls-eta8",
     ] {
         let dir = scratch(&format!("disks-{kernel}"));
         let out = umls(&[

@@ -238,11 +238,11 @@ fn kernel_support_keys_override_the_preset() {
     assert!(error.contains("kernel.sharpening"), "{error}");
 }
 
-/// `[kernel] diminishing_exponent` with `support_factor` on `umls` is `umls-eta-power`
+/// `[kernel] diminishing_exponent` with `support_factor` on `umls` is `umls-eta4`
 /// bit for bit, and an exponent of 0 (every ring vertex weighted alike, weights that jump
 /// across facets) is an error naming the key.
 #[test]
-fn the_diminishing_exponent_key_gives_the_eta_power_kernel() {
+fn the_diminishing_exponent_key_gives_the_eta4_kernel() {
     let end = Some(0.3);
     let keyed = variant(
         "hydrostatic-column",
@@ -251,18 +251,18 @@ fn the_diminishing_exponent_key_gives_the_eta_power_kernel() {
             "kind = \"umls\"\nsupport_factor = 1.4\ndiminishing_exponent = 4",
         )],
     );
-    let keyed = run(&keyed, &options("column-eta-power-key", None, end)).unwrap();
+    let keyed = run(&keyed, &options("column-eta4-key", None, end)).unwrap();
     let named = run(
         &Scene::load("hydrostatic-column").unwrap(),
-        &options("column-eta-power-name", Some(KernelKind::UmlsEtaPower), end),
+        &options("column-eta4-name", Some(KernelKind::UmlsEta4), end),
     )
     .unwrap();
-    assert_eq!(named.summary["kernel"], "umls-eta-power");
+    assert_eq!(named.summary["kernel"], "umls-eta4");
     let rms = |r: &umls_cli::run::RunReport| metric(&r.summary, "stress_rms");
     assert_eq!(rms(&keyed).to_bits(), rms(&named).to_bits());
     let plain = run(
         &Scene::load("hydrostatic-column").unwrap(),
-        &options("column-eta-power-plain", None, end),
+        &options("column-eta4-plain", None, end),
     )
     .unwrap();
     assert_ne!(rms(&plain).to_bits(), rms(&named).to_bits());
@@ -273,7 +273,7 @@ fn the_diminishing_exponent_key_gives_the_eta_power_kernel() {
             "kind = \"umls\"\ndiminishing_exponent = 0",
         )],
     );
-    let error = run(&bad, &options("column-eta-power-bad", None, Some(0.01)))
+    let error = run(&bad, &options("column-eta4-bad", None, Some(0.01)))
         .unwrap_err()
         .to_string();
     assert!(error.contains("kernel.diminishing_exponent"), "{error}");

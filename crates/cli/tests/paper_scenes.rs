@@ -53,7 +53,7 @@ fn vortex_converges_with_umls() {
     assert!(e1 < 0.3 && e2 < e1 / 3.0, "{e1} → {e2}");
 }
 
-/// `umls-eta-power` (weights η⁴ · d, support factor 1.4) keeps the default's accuracy on
+/// `umls-eta4` (weights η⁴ · d, support factor 1.4) keeps the default's accuracy on
 /// the vortex at h/2, where narrowing the stencil by distance failed (measured 0.0189
 /// against 0.0183; `umls-sharp` leaves the lattice), and it lowers the vibrating bar's
 /// stall with one particle per cell to a third (velocity RMSE 0.45·10⁻³ against
@@ -68,31 +68,25 @@ fn a_powered_diminishing_factor_keeps_the_vortex_and_lowers_the_bar_stall() {
         ],
     );
     let bar = Scene::load("vibrating-bar").unwrap();
-    let error = |scene: &Scene, kernel: KernelKind, name: &str, key: &str| {
-        let report = run(scene, &options(name, Some(kernel), None)).unwrap();
-        assert_eq!(report.summary["status"], "completed", "{}", report.summary);
-        metric(&report.summary, key)
+    // The metric `key` of `scene` run with `umls-eta4` and with `umls`.
+    let both = |scene: &Scene, label: &str, key: &str| {
+        let error = |kernel: KernelKind| {
+            let name = format!("{label}-{}", kernel.name());
+            let report = run(scene, &options(&name, Some(kernel), None)).unwrap();
+            assert_eq!(report.summary["status"], "completed", "{}", report.summary);
+            metric(&report.summary, key)
+        };
+        (error(KernelKind::UmlsEta4), error(KernelKind::Umls))
     };
-    let vortex = |kernel: KernelKind| {
-        let name = format!("vortex-60-{}", kernel.name());
-        error(&fine_vortex, kernel, &name, "displacement_error_max")
-    };
-    let (powered, plain) = (vortex(KernelKind::UmlsEtaPower), vortex(KernelKind::Umls));
+    let (powered, plain) = both(&fine_vortex, "vortex-60", "displacement_error_max");
     assert!(
         powered < 1.1 * plain,
-        "vortex: umls-eta-power {powered}, umls {plain}"
+        "vortex: umls-eta4 {powered}, umls {plain}"
     );
-    let bar_error = |kernel: KernelKind| {
-        let name = format!("bar-{}", kernel.name());
-        error(&bar, kernel, &name, "velocity_rmse")
-    };
-    let (powered, plain) = (
-        bar_error(KernelKind::UmlsEtaPower),
-        bar_error(KernelKind::Umls),
-    );
+    let (powered, plain) = both(&bar, "bar", "velocity_rmse");
     assert!(
         powered < 0.5 * plain,
-        "bar: umls-eta-power {powered}, umls {plain}"
+        "bar: umls-eta4 {powered}, umls {plain}"
     );
 }
 

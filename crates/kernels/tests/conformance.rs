@@ -31,16 +31,12 @@ fn conformance<const D: usize, K: Kernel<D>>(
     check_kernel(kernel, &points, outside).map_err(|v| TestCaseError::fail(v.to_string()))
 }
 
-/// The MLS settings of the CLI's `umls-eta-power`: weights η⁴ · d with the incident-edge
-/// support factor 1.4.
-fn powered<const D: usize>(mesh: &SimplexMesh<D>) -> UmlsKernel<D> {
-    UmlsKernel::with_weight(
-        mesh,
-        CubicBSpline,
-        SupportRadius::IncidentEdge { factor: 1.4 },
-    )
-    .and_then(|k| k.with_diminishing_exponent(4))
-    .unwrap()
+/// The MLS settings of the CLI's `umls-eta4` and `umls-eta8`: weights η^p · d with the
+/// incident-edge support `factor`.
+fn powered<const D: usize>(mesh: &SimplexMesh<D>, exponent: u32, factor: f64) -> UmlsKernel<D> {
+    UmlsKernel::with_weight(mesh, CubicBSpline, SupportRadius::IncidentEdge { factor })
+        .and_then(|k| k.with_diminishing_exponent(exponent))
+        .unwrap()
 }
 
 fn fractions(d: usize) -> impl Strategy<Value = Vec<f64>> {
@@ -69,7 +65,8 @@ proptest! {
         conformance(&Umls2::new(mesh.clone()), lo, hi, &f)?;
         conformance(&Umls2::new(mesh.clone()).with_gradient(GradientKind::Full), lo, hi, &f)?;
         conformance(&Umls2::new(mesh.clone()).with_gradient(GradientKind::FrozenEta), lo, hi, &f)?;
-        conformance(&Umls2::with_kernel(mesh.clone(), powered(&mesh)), lo, hi, &f)?;
+        conformance(&Umls2::with_kernel(mesh.clone(), powered(&mesh, 4, 1.4)), lo, hi, &f)?;
+        conformance(&Umls2::with_kernel(mesh.clone(), powered(&mesh, 8, 2.8)), lo, hi, &f)?;
         conformance(&LinearFeKernel::new(mesh), lo, hi, &f)?;
         // Same points mapped into the rotated square.
         let mapped: Vec<f64> = f.chunks_exact(2).flat_map(|c| {
@@ -88,7 +85,8 @@ proptest! {
         conformance(&Umls3::new(mesh.clone()), lo, hi, &f)?;
         conformance(&Umls3::new(mesh.clone()).with_gradient(GradientKind::Full), lo, hi, &f)?;
         conformance(&Umls3::new(mesh.clone()).with_gradient(GradientKind::FrozenEta), lo, hi, &f)?;
-        conformance(&Umls3::with_kernel(mesh.clone(), powered(&mesh)), lo, hi, &f)?;
+        conformance(&Umls3::with_kernel(mesh.clone(), powered(&mesh, 4, 1.4)), lo, hi, &f)?;
+        conformance(&Umls3::with_kernel(mesh.clone(), powered(&mesh, 8, 2.8)), lo, hi, &f)?;
         conformance(&LinearFeKernel::new(mesh), lo, hi, &f)?;
     }
 

@@ -298,10 +298,16 @@ fn every_umls_variant_is_continuous() {
             1,
         ),
         (
-            "eta-power",
+            "eta4",
             Profile::CubicBSpline,
             SupportRadius::IncidentEdge { factor: 1.4 },
             4,
+        ),
+        (
+            "eta8",
+            Profile::CubicBSpline,
+            SupportRadius::IncidentEdge { factor: 2.8 },
+            8,
         ),
     ];
     let tets = Lattice::new([0.0; 3], [1.0; 3], [3, 3, 3])

@@ -99,14 +99,14 @@ proptest! {
         check_fd::<2, 6, Quadratic, _>(&mesh, interior[s % interior.len()], &raw, WendlandC2)?;
     }
 
-    /// With η raised to a power (`umls-eta-power`'s 4, and 2 and 3) the full derivative
-    /// carries p η^{p−1} ∇η, checked the same way.
+    /// With η raised to a power (2 to 8; `umls-eta4` and `umls-eta8` use 4 and 8) the
+    /// full derivative carries p η^{p−1} ∇η, checked the same way.
     #[test]
     fn full_gradient_with_a_powered_diminishing_factor_matches_fd(
         mesh in common::rectangle(),
         cube in common::fine_cuboid(),
         s in any::<usize>(),
-        p in 2u32..=4,
+        p in 2u32..=8,
         raw in raw_weights(),
     ) {
         check_fd_powered::<2, 3, Linear, _>(&mesh, s % mesh.simplex_count(), &raw, CubicBSpline, p)?;
