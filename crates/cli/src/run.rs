@@ -256,13 +256,13 @@ fn run_dim<const D: usize, X: Dimension<D>>(
 }
 
 /// The UMLS kernel with its force's integration correction where `[kernel]
-/// integration_correction` (or the kernel name: `umls` corrects) asks for it.
+/// integration_correction` (or the kernel name's preset, [`umls_preset`]) asks for it.
 fn corrected<const D: usize, K: FromMls<D>>(ctx: &Context<'_, D>, kernel: K) -> Result<K> {
     let spec = &ctx.scene.spec.kernel;
-    if !spec.integration_correction.unwrap_or(matches!(
-        ctx.kernel,
-        KernelKind::Umls | KernelKind::UmlsEta4 | KernelKind::UmlsEta8
-    )) {
+    if !spec
+        .integration_correction
+        .unwrap_or(umls_preset(ctx.kernel).corrected)
+    {
         return Ok(kernel);
     }
     kernel.with_integration_correction().map_err(|e| {
@@ -273,8 +273,8 @@ fn corrected<const D: usize, K: FromMls<D>>(ctx: &Context<'_, D>, kernel: K) -> 
 
 /// The MLS settings of a UMLS kernel and its gradient kind: the kernel name's preset
 /// (profile, radius rule, factor, gradient, exponent of η), with `[kernel]`'s `weight`,
-/// `support`, `support_factor`, `gradient` and `diminishing_exponent` overriding it. The quadratic basis needs six (2D) or
-/// ten (3D) weighted samples, more than a vertex on a wall or in a corner has, so its
+/// `support`, `support_factor`, `gradient` and `diminishing_exponent` overriding it. The
+/// quadratic basis needs six (2D) or ten (3D) weighted samples, more than a vertex on a wall or in a corner has, so its
 /// quadratic terms carry a small ridge.
 fn umls_settings<const D: usize>(
     ctx: &Context<'_, D>,
@@ -336,57 +336,66 @@ struct UmlsPreset {
     gradient: GradientSpec,
     /// p of the weights η^p · d.
     exponent: u32,
+    /// Whether the force's gradients carry the integration correction ([`corrected`]).
+    corrected: bool,
 }
 
-/// Profile, radius rule, factor and gradient of each UMLS kernel name: the default
-/// `umls` with the one part the name changes (whether the force's gradients are
-/// corrected is decided by [`corrected`]: only `umls`, `umls-eta4` and `umls-eta8` are, by default).
+/// Profile, radius rule, factor, gradient, exponent of η and integration correction of
+/// each UMLS kernel name. `umls-eta4` and `umls-eta8` change one part of `umls`; the
+/// other names change one part of `umls-uncorrected`, the kernel their studies measured
+/// against.
 fn umls_preset(kind: KernelKind) -> UmlsPreset {
-    let default = UmlsPreset {
+    let umls = UmlsPreset {
         weight: WeightSpec::CubicBspline,
         support: SupportSpec::IncidentEdge,
         factor: DEFAULT_SUPPORT_FACTOR,
         gradient: GradientSpec::Reconstructed,
         exponent: 1,
+        corrected: true,
+    };
+    let uncorrected = UmlsPreset {
+        corrected: false,
+        ..umls
     };
     match kind {
+        KernelKind::Umls => umls,
         KernelKind::UmlsWide => UmlsPreset {
             support: SupportSpec::PerVertex,
             factor: 1.0,
-            ..default
+            ..uncorrected
         },
         KernelKind::UmlsPaper => UmlsPreset {
             support: SupportSpec::Global,
             factor: 1.0,
-            ..default
+            ..uncorrected
         },
         KernelKind::UmlsWendland => UmlsPreset {
             weight: WeightSpec::Wendland,
-            ..default
+            ..uncorrected
         },
         KernelKind::UmlsSharp => UmlsPreset {
             weight: WeightSpec::Sharpened,
-            ..default
+            ..uncorrected
         },
         KernelKind::UmlsFullGradient => UmlsPreset {
             gradient: GradientSpec::Full,
-            ..default
+            ..uncorrected
         },
         KernelKind::UmlsFrozenEta => UmlsPreset {
             gradient: GradientSpec::FrozenEta,
-            ..default
+            ..uncorrected
         },
         KernelKind::UmlsEta4 => UmlsPreset {
             factor: ETA4_SUPPORT_FACTOR,
             exponent: ETA4_EXPONENT,
-            ..default
+            ..umls
         },
         KernelKind::UmlsEta8 => UmlsPreset {
             factor: ETA8_SUPPORT_FACTOR,
             exponent: ETA8_EXPONENT,
-            ..default
+            ..umls
         },
-        _ => default,
+        _ => uncorrected,
     }
 }
 

@@ -8,23 +8,25 @@ use umls_cli::schema::KernelKind;
 mod runs;
 use runs::{metric, options, variant};
 
-/// The disks' summary with `kernel` and transfer `kind` (α 0.99 where it blends), run in
-/// the output directory `prefix-KERNEL-KIND`.
-fn disks_with(kernel: KernelKind, kind: &str, prefix: &str) -> serde_json::Value {
-    let scene = variant(
+/// The disks' summary with `kernel` and transfer `kind` (α 0.99 where it blends), the
+/// cells refined by `refine` (1: the scene's 20 × 20), run in the output directory
+/// `prefix-KERNEL-KIND`.
+fn disks_with(kernel: KernelKind, kind: &str, prefix: &str, refine: f64) -> serde_json::Value {
+    let mut scene = variant(
         "colliding-disks",
         &[("kind = \"flip\"", &format!("kind = \"{kind}\""))],
     );
+    umls_cli::edit::refine(&mut scene, refine).unwrap();
     let name = format!("{prefix}-{}-{kind}", kernel.name());
     run(&scene, &options(&name, Some(kernel), None))
         .unwrap()
         .summary
 }
 
-/// The fraction of the disks' energy lost by t = 3 with `kernel` and transfer `kind`, from
-/// a run that must complete without gaining energy.
-fn energy_lost(kernel: KernelKind, kind: &str, prefix: &str) -> f64 {
-    let summary = disks_with(kernel, kind, prefix);
+/// The fraction of the disks' energy lost by t = 3 with `kernel`, transfer `kind` and
+/// the cells refined by `refine`, from a run that must complete without gaining energy.
+fn energy_lost(kernel: KernelKind, kind: &str, prefix: &str, refine: f64) -> f64 {
+    let summary = disks_with(kernel, kind, prefix, refine);
     assert_eq!(summary["status"], "completed", "{summary}");
     assert!(metric(&summary, "energy_gain_max") < 1e-9, "{summary}");
     -metric(&summary, "energy_change_final")
@@ -37,7 +39,7 @@ fn energy_lost(kernel: KernelKind, kind: &str, prefix: &str) -> f64 {
 #[test]
 fn apic_flip_loses_less_energy_than_flip_on_the_disks() {
     let lost = |kernel: KernelKind, kind: &str| {
-        let summary = disks_with(kernel, kind, "disks");
+        let summary = disks_with(kernel, kind, "disks", 1.0);
         assert_eq!(
             summary["transfer"],
             format!("{kind} (alpha 0.99)"),
@@ -108,7 +110,7 @@ fn consistent_mass_keeps_the_disks_energy_under_apic() {
 /// *Sharpened weights*), so it is a variant, not the default.
 #[test]
 fn sharpened_weights_dissipate_like_quadratic_b_splines_under_apic() {
-    let lost = |kernel, kind| energy_lost(kernel, kind, "disks-sharp");
+    let lost = |kernel, kind| energy_lost(kernel, kind, "disks-sharp", 1.0);
     let sharp = lost(KernelKind::UmlsSharp, "apic");
     let plain = lost(KernelKind::UmlsUncorrected, "apic");
     let grid = lost(KernelKind::Bspline2, "apic");
@@ -133,7 +135,7 @@ fn sharpened_weights_dissipate_like_quadratic_b_splines_under_apic() {
 /// distance (docs/umls-kernel.md, *Powered diminishing factor*).
 #[test]
 fn a_powered_diminishing_factor_dissipates_less_on_the_disks() {
-    let lost = |kernel, kind| energy_lost(kernel, kind, "disks-eta4");
+    let lost = |kernel, kind| energy_lost(kernel, kind, "disks-eta4", 1.0);
     for (kind, gain) in [("apic", 0.03), ("flip", 0.02)] {
         let (powered, plain) = (
             lost(KernelKind::UmlsEta4, kind),
@@ -155,20 +157,8 @@ fn a_powered_diminishing_factor_dissipates_less_on_the_disks() {
 fn eta8_weights_bring_the_disks_within_five_points_of_quadratic_b_splines() {
     for refine in [1.0, 2.0] {
         for kind in ["flip", "apic"] {
-            let lost = |kernel: KernelKind| {
-                let mut scene = variant(
-                    "colliding-disks",
-                    &[("kind = \"flip\"", &format!("kind = \"{kind}\""))],
-                );
-                umls_cli::edit::refine(&mut scene, refine).unwrap();
-                let name = format!("disks-eta8-{}-{kind}-{refine}", kernel.name());
-                let summary = run(&scene, &options(&name, Some(kernel), None))
-                    .unwrap()
-                    .summary;
-                assert_eq!(summary["status"], "completed", "{summary}");
-                assert!(metric(&summary, "energy_gain_max") < 1e-9, "{summary}");
-                -metric(&summary, "energy_change_final")
-            };
+            let prefix = format!("disks-eta8-{refine}");
+            let lost = |kernel| energy_lost(kernel, kind, &prefix, refine);
             let (powered, grid) = (lost(KernelKind::UmlsEta8), lost(KernelKind::Bspline2));
             assert!(
                 powered > 0.0 && powered < grid + 0.05,

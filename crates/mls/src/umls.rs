@@ -232,11 +232,11 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
         let mut positions = [SVector::<f64, D>::zeros(); MAX_STENCIL];
         let mut weights = [0.0; MAX_STENCIL];
         let mut weight_gradients = [SVector::<f64, D>::zeros(); MAX_STENCIL];
+        let p = self.diminishing_exponent;
         for (i, (&v, &mask)) in ring.vertices.iter().zip(ring.masks).enumerate() {
             let xv = mesh.vertex(v as usize);
             let h = self.radii[v as usize];
             let (d, dd) = radial_weight(&self.weight, x, xv, h);
-            let p = self.diminishing_exponent;
             let linear = diminishing_factor(mask, lambda.as_slice());
             let eta = powered_diminishing(linear, p);
             positions[i] = *xv;
