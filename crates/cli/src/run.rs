@@ -35,7 +35,7 @@ use crate::progress::Progress;
 use crate::reference;
 use crate::scene::Scene;
 use crate::schema::{
-    EncodingSpec, GradientSpec, KernelKind, SupportSpec, TransferKind, WeightSpec,
+    EncodingSpec, ForcePosition, GradientSpec, KernelKind, SupportSpec, TransferKind, WeightSpec,
 };
 use crate::setup::{self, Setup, Split};
 use crate::{conditions, end_metrics};
@@ -572,13 +572,26 @@ fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     settings.mass_matrix = crate::schema::MassSpec::matrix(ctx.scene.spec.transfer.mass);
     settings.damping = ctx.setup.damping;
     let mut sim = Simulation::new(kernel, table, transfer, particles, settings)?;
-    if let Some(field) = &ctx.setup.body_force {
+    if let Some((field, position)) = &ctx.setup.body_force {
         let (field, frame) = (field.clone(), ctx.setup.frame);
+        // The seeds are where the particles start, in the particles' order.
+        let reference: Option<Vec<SVector<f64, D>>> =
+            (*position == ForcePosition::Reference).then(|| {
+                seeds
+                    .position
+                    .iter()
+                    .map(|x| frame.point_to_scene(x))
+                    .collect()
+            });
         // An evaluation error (none is expected: the field was evaluated at every
         // particle before the run) gives NaN, which the engine stops at.
-        sim.body_force = Some(Arc::new(move |x: &SVector<f64, D>, t: f64| {
+        sim.body_force = Some(Arc::new(move |p: usize, x: &SVector<f64, D>, t: f64| {
+            let at = match &reference {
+                Some(start) => start[p],
+                None => frame.point_to_scene(x),
+            };
             field
-                .eval(&frame.point_to_scene(x), t)
+                .eval(&at, t)
                 .map(|b| frame.vector_to_world(&b))
                 .unwrap_or_else(|_| SVector::from_element(f64::NAN))
         }));

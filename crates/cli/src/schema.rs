@@ -65,8 +65,25 @@ pub struct ProfileSpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodyForceSpec {
-    /// D components: acceleration b(x, t) at a particle's current position x.
+    /// D components: acceleration b(x, t), with x the position `position` names.
     pub acceleration: Vec<Component>,
+    /// Which position of a particle x stands for in `acceleration`.
+    #[serde(default)]
+    pub position: ForcePosition,
+}
+
+/// `[body_force] position`: where a particle's body force is evaluated.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ForcePosition {
+    /// Where the particle is now: a field of space (a trap, a centrifuge).
+    #[default]
+    Current,
+    /// Where the particle started, X: a field of the material, as a manufactured
+    /// solution's force is (b(X, t) makes the exact motion a solution for each particle,
+    /// whereas at a drifted current position it acts with the force meant for another
+    /// place).
+    Reference,
 }
 
 /// `[transform]`: the scene as written is turned by `rotation` degrees (counter-clockwise

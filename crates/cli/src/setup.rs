@@ -21,8 +21,8 @@ use crate::hydrostatic::Hydrostatic;
 use crate::probes::ProbeReference;
 use crate::scene::Scene;
 use crate::schema::{
-    BoundaryKind, DiagonalSpec, Imposed, MaterialSpec, QuadratureSpec, RegionSpec, SeedingSpec,
-    SolidSpec, StressUpdateSpec, VelocityTimeSpec,
+    BoundaryKind, DiagonalSpec, ForcePosition, Imposed, MaterialSpec, QuadratureSpec, RegionSpec,
+    SeedingSpec, SolidSpec, StressUpdateSpec, VelocityTimeSpec,
 };
 use umls_constitutive::table::{ElasticModel, Model, PlasticModel};
 
@@ -111,8 +111,9 @@ pub struct Setup<const D: usize> {
     pub probe_reference: Option<ProbeReference<D>>,
     /// The wall whose pressure is measured: boundary index, centre (world), area.
     pub pressure: Option<(usize, SVector<f64, D>, f64)>,
-    /// The body acceleration b(x, t) (scene frame), added to gravity.
-    pub body_force: Option<VectorField<D>>,
+    /// The body acceleration b(x, t) (scene frame), added to gravity, and whether x is
+    /// the particle's current or its reference position.
+    pub body_force: Option<(VectorField<D>, ForcePosition)>,
     /// The rotation from the scene as written into the world it runs in; everything
     /// above except the references is already in the world frame.
     pub frame: SceneFrame<D>,
@@ -912,7 +913,7 @@ pub fn build_for<const D: usize>(
                     ));
                 }
             }
-            Some(field)
+            Some((field, b.position))
         }
     };
     let probe_reference = match spec.reference.as_ref().and_then(|r| r.probe.as_ref()) {

@@ -24,8 +24,123 @@ fn vortex_seeds_the_annulus() {
     }));
 }
 
+/// The vortex's body force is the manufactured solution's, b = a − ∇·σ / ρ, as a field of
+/// the reference position: a from central differences in time of the exact motion
+/// x = Q(α(R, t)) X, σ = μ (F Fᵀ − I) (neo-Hookean at J = 1) from the exact F, and its
+/// divergence from central differences in the current position.
+#[test]
+fn the_vortex_body_force_is_the_manufactured_solutions() {
+    use nalgebra::{Matrix2, Rotation2, Vector2};
+    use umls_cli::schema::ForcePosition;
+    let setup = build::<2>(&Scene::load("vortex").unwrap(), triangles).unwrap();
+    let (field, position) = setup.body_force.as_ref().unwrap();
+    assert_eq!(*position, ForcePosition::Reference);
+    let (amp, rho) = (0.25, 1000.0);
+    let mu = 1000.0 / (2.0 * 1.3);
+    let h = |r: f64| 1.0 - 32.0 * (r - 1.0).powi(2) + 256.0 * (r - 1.0).powi(4);
+    let dh = |r: f64| -64.0 * (r - 1.0) + 1024.0 * (r - 1.0).powi(3);
+    let alpha = |r: f64, t: f64| amp * (std::f64::consts::PI * t).sin() * h(r);
+    let motion = |x0: Vector2<f64>, t: f64| Rotation2::new(alpha(x0.norm(), t)) * x0;
+    // The stress at a current point: the radius is kept, so X = Q(−α(|x|)) x, and
+    // F = Q (I + J X ⊗ ∇α) with J the quarter turn and ∇α = α' X / R.
+    let stress = |x: Vector2<f64>, t: f64| {
+        let r = x.norm();
+        let a = alpha(r, t);
+        let x0 = Rotation2::new(-a) * x;
+        let slope = amp * (std::f64::consts::PI * t).sin() * dh(r) / r * x0;
+        let quarter = Matrix2::new(0.0, -1.0, 1.0, 0.0);
+        let f =
+            Rotation2::new(a).matrix() * (Matrix2::identity() + quarter * x0 * slope.transpose());
+        assert!((f.determinant() - 1.0).abs() < 1e-12);
+        (f * f.transpose() - Matrix2::identity()) * mu
+    };
+    let (dt, dx) = (1e-4, 1e-4);
+    let mut checked = 0;
+    for &t in &[0.1, 0.35, 0.8] {
+        for &r in &[0.76, 0.85, 1.0, 1.13, 1.24] {
+            for &angle in &[0.3f64, 2.0, 4.4] {
+                let x0 = Vector2::new(r * angle.cos(), r * angle.sin());
+                let a = (motion(x0, t + dt) - 2.0 * motion(x0, t) + motion(x0, t - dt)) / (dt * dt);
+                let x = motion(x0, t);
+                let mut divergence = Vector2::zeros();
+                for k in 0..2 {
+                    let step = Vector2::ith(k, dx);
+                    let d = (stress(x + step, t) - stress(x - step, t)) / (2.0 * dx);
+                    divergence += d.row(k).transpose();
+                }
+                let expected = a - divergence / rho;
+                let b = field.eval(&x0, t).unwrap();
+                assert!(
+                    (b - expected).norm() < 1e-5 * (1.0 + expected.norm()),
+                    "R = {r}, θ = {angle}, t = {t}: {b:?} against {expected:?}"
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert_eq!(checked, 45);
+}
+
+/// `[body_force] position = "reference"` evaluates the field where each particle
+/// started: the vortex annulus sent off at 0.5 along x under b = (1 + x, 0) gains
+/// t Σ m_p (1 + X_p) of momentum (internal forces cancel, nothing holds it), while the
+/// same field at the current positions adds the drift's ∫ Σ m_p 0.5 t = M · 0.5 t² / 2
+/// as well (summed over the explicit steps: within half of it either way).
+#[test]
+fn a_reference_body_force_acts_where_each_particle_started() {
+    let edits = |position: &'static str| {
+        [
+            (
+                "velocity = [\"-amp * PI * h * y\", \"amp * PI * h * x\"]",
+                "velocity = [\"0.5\", \"0\"]",
+            ),
+            ("[body_force]\nposition = \"reference\"", position),
+            (
+                "acceleration = [\"cos_a * b_x0 - sin_a * b_y0\", \"sin_a * b_x0 + cos_a * b_y0\"]",
+                "acceleration = [\"1 + x\", \"0\"]",
+            ),
+        ]
+    };
+    let reference = variant("vortex", &edits("[body_force]\nposition = \"reference\""));
+    let current = variant("vortex", &edits("[body_force]\nposition = \"current\""));
+    let seeds = build::<2>(&reference, triangles).unwrap().seeds;
+    let total: f64 = seeds.mass.iter().sum();
+    let first: f64 = seeds
+        .mass
+        .iter()
+        .zip(&seeds.position)
+        .map(|(m, x)| m * (1.0 + x[0]))
+        .sum();
+    let momentum = |scene: &Scene, name: &str| {
+        let report = run(scene, &options(name, Some(KernelKind::Umls), Some(0.2))).unwrap();
+        assert_eq!(report.summary["status"], "completed", "{}", report.summary);
+        let history = History::read(&options(name, None, None).out);
+        let (t, p) = (history.column("time"), history.column("momentum_x"));
+        history
+            .rows
+            .iter()
+            .map(|row| (row[t], row[p]))
+            .collect::<Vec<_>>()
+    };
+    let at_start = momentum(&reference, "force-at-reference");
+    for &(t, p) in &at_start {
+        let expected = 0.5 * total + t * first;
+        assert!(
+            (p - expected).abs() < 1e-9 * total,
+            "t = {t}: {p} against {expected}"
+        );
+    }
+    let (t, p) = *momentum(&current, "force-at-current").last().unwrap();
+    let drift = 0.5 * total * 0.5 * t * t;
+    let gained = p - 0.5 * total - t * first;
+    assert!(
+        t > 0.19 && (gained - drift).abs() < 0.5 * drift,
+        "t = {t}: {gained} against {drift}"
+    );
+}
+
 /// UMLS on the vortex with the cells halved: the displacement error against the
-/// manufactured solution falls by more than 3 (order > 1.6; 2.6 measured).
+/// manufactured solution falls by more than 3 (order > 1.58; 2.36 measured: 0.0792 → 0.0154).
 #[test]
 fn vortex_converges_with_umls() {
     let coarse = run(
@@ -54,8 +169,9 @@ fn vortex_converges_with_umls() {
 }
 
 /// `umls-eta4` (weights η⁴ · d, support factor 1.4) keeps the default's accuracy on
-/// the vortex at h/2, where narrowing the stencil by distance failed (measured 0.0189
-/// against 0.0183; `umls-sharp` leaves the lattice), and it lowers the vibrating bar's
+/// the vortex at h/2, where narrowing the stencil by distance failed (measured 0.0144
+/// against 0.0154; `umls-sharp` leaves the lattice; at h/4 it stops converging,
+/// docs/umls-kernel.md), and it lowers the vibrating bar's
 /// stall with one particle per cell to a third (velocity RMSE 0.45·10⁻³ against
 /// 1.36·10⁻³; bspline2 0.26·10⁻³): docs/umls-kernel.md, *Powered diminishing factor*.
 #[test]

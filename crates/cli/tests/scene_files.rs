@@ -182,8 +182,8 @@ fn bad_values_name_their_key() {
         ("vortex", "b_r = \"-r", "b_r = \"q - r", "`definitions.b_r`"),
         (
             "vortex",
-            "acceleration = [\"(b_r",
-            "acceleration = [\"1 / 0 + (b_r",
+            "acceleration = [\"cos_a",
+            "acceleration = [\"1 / 0 + cos_a",
             "`body_force.acceleration`",
         ),
         (

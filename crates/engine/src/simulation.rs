@@ -25,9 +25,15 @@ mod mass_matrix;
 mod musl;
 mod particles_to_grid;
 
-/// A body acceleration field b(x, t), added to gravity.
+/// A body acceleration b(p, x, t), added to gravity: called with the particle's index p
+/// (its place in [`Simulation::particles`], which the engine never reorders), its current position x
+/// and the time. The index lets a field depend on where the particle started: a
+/// manufactured solution's force is a function of the reference position X, and
+/// evaluated at the current position instead it acts on a particle that drifts off the
+/// exact motion with the force meant for another place (the `vortex` scene's rim
+/// particles were pushed further out by it, docs/scenes.md).
 pub type BodyForce<const D: usize> =
-    std::sync::Arc<dyn Fn(&SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync>;
+    std::sync::Arc<dyn Fn(usize, &SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync>;
 
 /// Refuses what a fused-force transfer (MLS-MPM) cannot do: its D_p⁻¹ must be one
 /// constant (B-splines), and with no separate nodal force neither damping nor MUSL's
@@ -88,7 +94,7 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     pub boundary: Boundary<D>,
     /// Step settings.
     pub settings: StepSettings<D>,
-    /// Optional body acceleration field b(x, t), added to `settings.gravity`.
+    /// Optional body acceleration b(p, x, t), added to `settings.gravity`.
     pub body_force: Option<BodyForce<D>>,
     step: usize,
     time: f64,

@@ -138,7 +138,9 @@ fn body_force_fields() {
         StepSettings::new(1e-3),
     )
     .unwrap();
-    b.body_force = Some(Arc::new(|_: &Vector2<f64>, _: f64| Vector2::new(0.0, -G)));
+    b.body_force = Some(Arc::new(|_: usize, _: &Vector2<f64>, _: f64| {
+        Vector2::new(0.0, -G)
+    }));
     for _ in 0..5 {
         a.step().unwrap();
         b.step().unwrap();
@@ -155,7 +157,9 @@ fn body_force_fields() {
         StepSettings::new(1e-3),
     )
     .unwrap();
-    trap.body_force = Some(Arc::new(move |x: &Vector2<f64>, _: f64| (x - centre) * -k));
+    trap.body_force = Some(Arc::new(move |_: usize, x: &Vector2<f64>, _: f64| {
+        (x - centre) * -k
+    }));
     for _ in 0..5 {
         let before = trap.diagnostics().unwrap().momentum;
         let impulse: Vector2<f64> = trap
@@ -173,6 +177,45 @@ fn body_force_fields() {
             after - before
         );
     }
+    // A field of where each particle started, through its index: the impulse is
+    // Δt Σ m_p b(X_p) every step however far the particles have moved.
+    let mut reference = Simulation::new(
+        Umls2::new(slope()),
+        material,
+        Pic,
+        block(),
+        StepSettings::new(1e-3),
+    )
+    .unwrap();
+    let start = reference.particles().position.clone();
+    let field = move |p: usize| (start[p] - centre) * -k;
+    let force = field.clone();
+    reference.body_force = Some(Arc::new(move |p: usize, _: &Vector2<f64>, _: f64| force(p)));
+    let impulse: Vector2<f64> = (0..reference.particles().len())
+        .map(|p| field(p) * (reference.particles().mass[p] * 1e-3))
+        .sum();
+    for _ in 0..5 {
+        let before = reference.diagnostics().unwrap().momentum;
+        reference.step().unwrap();
+        let after = reference.diagnostics().unwrap().momentum;
+        assert!(
+            (after - before - impulse).norm() < 1e-12 * impulse.norm(),
+            "{:?} vs {impulse:?}",
+            after - before
+        );
+    }
+    // The particles have moved, so the same field at their current positions would
+    // have given another impulse: the index is what made the difference.
+    let current: Vector2<f64> = (0..reference.particles().len())
+        .map(|p| {
+            let x = reference.particles().position[p];
+            (x - centre) * (-k * reference.particles().mass[p] * 1e-3)
+        })
+        .sum();
+    assert!(
+        (current - impulse).norm() > 1e-9 * impulse.norm(),
+        "{current:?} vs {impulse:?}"
+    );
 }
 
 /// Boundary conditions on planes select the nodes on the plane and use its normal.

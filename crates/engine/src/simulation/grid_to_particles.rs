@@ -220,7 +220,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                             &velocity[k],
                             dt,
                         )?;
-                        let acceleration = body_force.map_or(gravity, |b| gravity + b(&x, time));
+                        let acceleration = body_force.map_or(gravity, |b| gravity + b(i, &x, time));
                         power += p.mass[i] * acceleration.dot(&(velocity[k] + u.velocity)) * 0.5;
                         let moved = (u.position - x).norm();
                         if moved > longest.1 {

@@ -147,7 +147,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     let volume = p.volume[i];
                     let stress_volume = stresses[i] * volume;
                     let acceleration =
-                        gravity + body_force.map_or(SVector::zeros(), |b| b(&x, time));
+                        gravity + body_force.map_or(SVector::zeros(), |b| b(i, &x, time));
                     let mut sink = ScatterEntry::<D, T, CORRECTED, A> {
                         window,
                         affine: SMatrix::zeros(),
