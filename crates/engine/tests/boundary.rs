@@ -127,91 +127,76 @@ fn body_force_fields() {
     let material = NeoHookean {
         parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
     };
+    // The block on the slope's mesh under `force`, without gravity or walls.
+    let free = |force: umls_engine::BodyForce<2>| {
+        let mut sim = Simulation::new(
+            Umls2::new(slope()),
+            material,
+            Pic,
+            block(),
+            StepSettings::new(1e-3),
+        )
+        .unwrap();
+        sim.body_force = Some(force);
+        sim
+    };
     let mut with_gravity = StepSettings::new(1e-3);
     with_gravity.gravity = Vector2::new(0.0, -G);
     let mut a = Simulation::new(Umls2::new(slope()), material, Pic, block(), with_gravity).unwrap();
-    let mut b = Simulation::new(
-        Umls2::new(slope()),
-        material,
-        Pic,
-        block(),
-        StepSettings::new(1e-3),
-    )
-    .unwrap();
-    b.body_force = Some(Arc::new(|_: usize, _: &Vector2<f64>, _: f64| {
-        Vector2::new(0.0, -G)
-    }));
+    let mut b = free(Arc::new(|_, _, _| Vector2::new(0.0, -G)));
     for _ in 0..5 {
         a.step().unwrap();
         b.step().unwrap();
     }
     assert_eq!(a.particles().position, b.particles().position);
-    // A harmonic trap b(x) = −k (x − c).
-    let centre = Vector2::new(1.0, 0.5);
-    let k = 40.0;
-    let mut trap = Simulation::new(
-        Umls2::new(slope()),
-        material,
-        Pic,
-        block(),
-        StepSettings::new(1e-3),
-    )
-    .unwrap();
-    trap.body_force = Some(Arc::new(move |_: usize, x: &Vector2<f64>, _: f64| {
-        (x - centre) * -k
-    }));
-    for _ in 0..5 {
-        let before = trap.diagnostics().unwrap().momentum;
-        let impulse: Vector2<f64> = trap
-            .particles()
-            .position
-            .iter()
-            .zip(&trap.particles().mass)
-            .map(|(x, m)| (x - centre) * (-k * m * 1e-3))
-            .sum();
-        trap.step().unwrap();
-        let after = trap.diagnostics().unwrap().momentum;
+    // A step changes the momentum by exactly `impulse`, what the force gave this step.
+    fn step_gives<K: umls_transfer::Kernel<2>, M: umls_constitutive::Constitutive<2>>(
+        sim: &mut Simulation<2, K, M, Pic>,
+        impulse: Vector2<f64>,
+    ) {
+        let before = sim.diagnostics().unwrap().momentum;
+        sim.step().unwrap();
+        let after = sim.diagnostics().unwrap().momentum;
         assert!(
             (after - before - impulse).norm() < 1e-12 * impulse.norm().max(1e-3),
             "{:?} vs {impulse:?}",
             after - before
         );
     }
-    // A field of where each particle started, through its index: the impulse is
-    // Δt Σ m_p b(X_p) every step however far the particles have moved.
-    let mut reference = Simulation::new(
-        Umls2::new(slope()),
-        material,
-        Pic,
-        block(),
-        StepSettings::new(1e-3),
-    )
-    .unwrap();
-    let start = reference.particles().position.clone();
-    let field = move |p: usize| (start[p] - centre) * -k;
-    let force = field.clone();
-    reference.body_force = Some(Arc::new(move |p: usize, _: &Vector2<f64>, _: f64| force(p)));
-    let impulse: Vector2<f64> = (0..reference.particles().len())
-        .map(|p| field(p) * (reference.particles().mass[p] * 1e-3))
+    // A harmonic trap b(x) = −k (x − c), at the current positions.
+    let centre = Vector2::new(1.0, 0.5);
+    let k = 40.0;
+    let trap_at = move |x: Vector2<f64>| (x - centre) * -k;
+    let mut trap = free(Arc::new(move |_, x, _| trap_at(*x)));
+    // Δt Σ m_p b(x_p) of a simulation's particles now.
+    let impulse_at_current = |sim: &Simulation<2, _, _, Pic>| -> Vector2<f64> {
+        let p = sim.particles();
+        p.position
+            .iter()
+            .zip(&p.mass)
+            .map(|(x, m)| trap_at(*x) * (m * 1e-3))
+            .sum()
+    };
+    for _ in 0..5 {
+        let impulse = impulse_at_current(&trap);
+        step_gives(&mut trap, impulse);
+    }
+    // The same trap as a field of where each particle started, through its index: the
+    // impulse is Δt Σ m_p b(X_p) every step however far the particles have moved.
+    let start = block().position;
+    let at_start = start.clone();
+    let mut reference = free(Arc::new(move |p, _, _| trap_at(at_start[p])));
+    let impulse: Vector2<f64> = start
+        .iter()
+        .zip(&reference.particles().mass)
+        .map(|(x, m)| trap_at(*x) * (m * 1e-3))
         .sum();
     for _ in 0..5 {
-        let before = reference.diagnostics().unwrap().momentum;
-        reference.step().unwrap();
-        let after = reference.diagnostics().unwrap().momentum;
-        assert!(
-            (after - before - impulse).norm() < 1e-12 * impulse.norm(),
-            "{:?} vs {impulse:?}",
-            after - before
-        );
+        step_gives(&mut reference, impulse);
     }
-    // The particles have moved, so the same field at their current positions would
-    // have given another impulse: the index is what made the difference.
-    let current: Vector2<f64> = (0..reference.particles().len())
-        .map(|p| {
-            let x = reference.particles().position[p];
-            (x - centre) * (-k * reference.particles().mass[p] * 1e-3)
-        })
-        .sum();
+    // The particles have moved, so the field at their current positions would have
+    // given another impulse: the index is what made the difference.
+    let current = impulse_at_current(&reference);
     assert!(
         (current - impulse).norm() > 1e-9 * impulse.norm(),
         "{current:?} vs {impulse:?}"
