@@ -170,9 +170,9 @@ fn vortex_converges_with_umls() {
 
 /// `umls-eta4` (weights η⁴ · d, support factor 1.4) keeps the default's accuracy on
 /// the vortex at h/2, where narrowing the stencil by distance failed (measured 0.0144
-/// against 0.0154; `umls-sharp` leaves the lattice; at h/4 it stops converging,
-/// docs/umls-kernel.md), and it lowers the vibrating bar's
-/// stall with one particle per cell to a third (velocity RMSE 0.45·10⁻³ against
+/// against 0.0154; `umls-sharp` leaves the lattice; at h/4 it converges with nine
+/// particles per cell, not with the scene's four: docs/umls-kernel.md), and it lowers the
+/// vibrating bar's stall with one particle per cell to a third (velocity RMSE 0.45·10⁻³ against
 /// 1.36·10⁻³; bspline2 0.26·10⁻³): docs/umls-kernel.md, *Powered diminishing factor*.
 #[test]
 fn a_powered_diminishing_factor_keeps_the_vortex_and_lowers_the_bar_stall() {
