@@ -311,7 +311,20 @@ pub fn value_text(value: &toml::Value) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::transfer_edits;
+    use super::{BUILTIN, Matrix, transfer_edits};
+
+    /// The built-in matrices are read at run time, so an edit that breaks one would
+    /// otherwise surface only when someone runs the report.
+    #[test]
+    fn built_in_matrices_parse_and_name_kernels_in_every_study() {
+        for (name, _) in BUILTIN {
+            let matrix = Matrix::load(name).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(!matrix.accuracy.is_empty(), "{name}");
+            for study in matrix.studies() {
+                assert!(!study.kernels.is_empty(), "{name}: {}", study.name);
+            }
+        }
+    }
 
     #[test]
     fn transfer_names_become_scene_edits() {
