@@ -274,8 +274,8 @@ fn corrected<const D: usize, K: FromMls<D>>(ctx: &Context<'_, D>, kernel: K) -> 
 /// The MLS settings of a UMLS kernel and its gradient kind: the kernel name's preset
 /// (profile, radius rule, factor, gradient, exponent of η), with `[kernel]`'s `weight`,
 /// `support`, `support_factor`, `gradient` and `diminishing_exponent` overriding it. The
-/// quadratic basis needs six (2D) or ten (3D) weighted samples, more than a vertex on a wall or in a corner has, so its
-/// quadratic terms carry a small ridge.
+/// quadratic basis needs six (2D) or ten (3D) weighted samples, more than a vertex on a
+/// wall or in a corner has, so its quadratic terms carry a small ridge.
 fn umls_settings<const D: usize>(
     ctx: &Context<'_, D>,
     mesh: &SimplexMesh<D>,
@@ -612,7 +612,6 @@ pub(crate) trait Run<const D: usize> {
     fn stable_time_step(&self, cfl: f64) -> f64;
     fn set_geostatic_stress(&mut self, k0: f64) -> std::result::Result<(), EngineError>;
     fn spacing(&self) -> f64;
-    /// Adds a wall; the number of nodes it constrains.
     /// Adds a wall; the nodes it constrains.
     fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> Vec<u32>;
     /// The constraint forces of the boundary's reaction sets in the last step.

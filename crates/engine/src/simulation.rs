@@ -17,6 +17,7 @@ use crate::stencils::Stencils;
 use crate::timing::{Lap, StageTimes};
 use crate::transfer::{StressUpdate, TransferScheme};
 
+mod body_forces;
 mod checks;
 mod constitutive;
 mod fitted_clamps;
@@ -107,6 +108,9 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     // Per-particle buffers the step reuses, so a step allocates nothing once they have
     // grown to the particle count.
     stress_buffer: Vec<SMatrix<f64, D, D>>,
+    /// This step's body accelerations b(p, x_p, t), one per particle (empty without a
+    /// body force), evaluated once for P2G and G2P.
+    body_accelerations: Vec<SVector<f64, D>>,
     /// Whether `stress_buffer` holds the stresses of the particles' current F and state
     /// under the current material (left by the last deformation update; cleared by
     /// every mutable access to particles or material).
@@ -245,6 +249,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             scatter: Default::default(),
             times: StageTimes::default(),
             stress_buffer: Vec::new(),
+            body_accelerations: Vec::new(),
             stresses_current: false,
             reactions: Default::default(),
             clamp_systems: Vec::new(),
@@ -311,7 +316,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 + bytes(&p.mass)
                 + bytes(&p.state)
                 + bytes(&p.cache),
-            particle_scratch: bytes(&self.stress_buffer) + ranges + order,
+            particle_scratch: bytes(&self.stress_buffer)
+                + bytes(&self.body_accelerations)
+                + ranges
+                + order,
             stencils: stored,
             nodes: self.grid.bytes()
                 + windows
@@ -555,6 +563,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // 2. Stresses, then P2G.
         self.compute_stresses()?;
         self.times.constitutive += clock.lap();
+        self.evaluate_body_forces();
         self.particles_to_grid()?;
         self.iterate_mass_matrix()?;
         self.times.particles_to_grid += clock.lap();

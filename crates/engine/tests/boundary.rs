@@ -149,6 +149,11 @@ fn body_force_fields() {
         b.step().unwrap();
     }
     assert_eq!(a.particles().position, b.particles().position);
+    // The work of the force G2P sums is gravity's, bit for bit: both read one acceleration.
+    assert_eq!(
+        a.diagnostics().unwrap().external_work,
+        b.diagnostics().unwrap().external_work
+    );
     // A step changes the momentum by exactly `impulse`, what the force gave this step.
     fn step_gives<K: umls_transfer::Kernel<2>, M: umls_constitutive::Constitutive<2>>(
         sim: &mut Simulation<2, K, M, Pic>,
@@ -201,6 +206,36 @@ fn body_force_fields() {
         (current - impulse).norm() > 1e-9 * impulse.norm(),
         "{current:?} vs {impulse:?}"
     );
+}
+
+/// A step evaluates the body force once per particle: P2G's force and G2P's work of
+/// external forces read the same value (a scene's expression can cost more than the
+/// rest of the step).
+#[test]
+fn a_body_force_is_evaluated_once_per_particle_and_step() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let material = NeoHookean {
+        parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
+    };
+    let calls = Arc::new(AtomicUsize::new(0));
+    let counter = calls.clone();
+    let mut sim = Simulation::new(
+        Umls2::new(slope()),
+        material,
+        Pic,
+        block(),
+        StepSettings::new(1e-3),
+    )
+    .unwrap();
+    sim.body_force = Some(Arc::new(move |_, _, _| {
+        counter.fetch_add(1, Ordering::Relaxed);
+        Vector2::new(0.5, -G)
+    }));
+    let steps = 4;
+    for _ in 0..steps {
+        sim.step().unwrap();
+    }
+    assert_eq!(calls.load(Ordering::Relaxed), steps * sim.particles().len());
 }
 
 /// Boundary conditions on planes select the nodes on the plane and use its normal.

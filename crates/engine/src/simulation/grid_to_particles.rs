@@ -170,8 +170,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             new: &self.grid.new_velocity,
         };
         let p = &mut self.particles;
-        let (gravity, time, step) = (self.settings.gravity_at(self.time), self.time, self.step);
-        let body_force = self.body_force.as_ref();
+        let (gravity, step) = (self.settings.gravity_at(self.time), self.step);
+        let body = &self.body_accelerations;
         let boundary = &self.boundary;
         // The node marks are built at the first particle that leaves the kernel's
         // domain (mesh kernels at walls given as node sets), not every step: a grid
@@ -220,7 +220,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                             &velocity[k],
                             dt,
                         )?;
-                        let acceleration = body_force.map_or(gravity, |b| gravity + b(i, &x, time));
+                        let acceleration = body.get(i).map_or(gravity, |b| gravity + b);
                         power += p.mass[i] * acceleration.dot(&(velocity[k] + u.velocity)) * 0.5;
                         let moved = (u.position - x).norm();
                         if moved > longest.1 {

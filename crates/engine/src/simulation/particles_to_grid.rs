@@ -118,7 +118,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let p = &self.particles;
         let (stencils, kernel, time, step) = (&self.stencils, &self.kernel, self.time, self.step);
         let gravity = self.settings.gravity_at(time);
-        let body_force = self.body_force.as_ref();
+        let body = &self.body_accelerations;
         let g = &mut self.grid;
         let sums = crate::scatter::NodalSums {
             mass: &mut g.mass,
@@ -147,7 +147,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     let volume = p.volume[i];
                     let stress_volume = stresses[i] * volume;
                     let acceleration =
-                        gravity + body_force.map_or(SVector::zeros(), |b| b(i, &x, time));
+                        gravity + body.get(i).copied().unwrap_or_else(SVector::zeros);
                     let mut sink = ScatterEntry::<D, T, CORRECTED, A> {
                         window,
                         affine: SMatrix::zeros(),
