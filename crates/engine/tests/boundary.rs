@@ -119,27 +119,34 @@ fn without_slip_the_block_falls_out_of_the_mesh() {
     );
 }
 
+/// The material of the body-force tests' block.
+fn block_material() -> NeoHookean {
+    NeoHookean {
+        parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
+    }
+}
+
+/// The block on the slope's mesh under `force`, without gravity or walls.
+fn block_under(force: umls_engine::BodyForce<2>) -> Simulation<2, Umls2, NeoHookean, Pic> {
+    let mut sim = Simulation::new(
+        Umls2::new(slope()),
+        block_material(),
+        Pic,
+        block(),
+        StepSettings::new(1e-3),
+    )
+    .unwrap();
+    sim.body_force = Some(force);
+    sim
+}
+
 /// A body-force field enters like gravity: a constant field reproduces the gravity run
 /// bit for bit, and with no boundary conditions the momentum changes by exactly
 /// Δt Σ m_p b(x_p) per step (internal forces cancel).
 #[test]
 fn body_force_fields() {
-    let material = NeoHookean {
-        parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
-    };
-    // The block on the slope's mesh under `force`, without gravity or walls.
-    let free = |force: umls_engine::BodyForce<2>| {
-        let mut sim = Simulation::new(
-            Umls2::new(slope()),
-            material,
-            Pic,
-            block(),
-            StepSettings::new(1e-3),
-        )
-        .unwrap();
-        sim.body_force = Some(force);
-        sim
-    };
+    let material = block_material();
+    let free = block_under;
     let mut with_gravity = StepSettings::new(1e-3);
     with_gravity.gravity = Vector2::new(0.0, -G);
     let mut a = Simulation::new(Umls2::new(slope()), material, Pic, block(), with_gravity).unwrap();
@@ -214,20 +221,9 @@ fn body_force_fields() {
 #[test]
 fn a_body_force_is_evaluated_once_per_particle_and_step() {
     use std::sync::atomic::{AtomicUsize, Ordering};
-    let material = NeoHookean {
-        parameters: ElasticParameters::from_young_poisson(1e5, 0.3).unwrap(),
-    };
     let calls = Arc::new(AtomicUsize::new(0));
     let counter = calls.clone();
-    let mut sim = Simulation::new(
-        Umls2::new(slope()),
-        material,
-        Pic,
-        block(),
-        StepSettings::new(1e-3),
-    )
-    .unwrap();
-    sim.body_force = Some(Arc::new(move |_, _, _| {
+    let mut sim = block_under(Arc::new(move |_, _, _| {
         counter.fetch_add(1, Ordering::Relaxed);
         Vector2::new(0.5, -G)
     }));
