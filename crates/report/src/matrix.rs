@@ -15,7 +15,8 @@ use serde::Deserialize;
 
 use crate::error::{ReportError, Result};
 
-/// The built-in matrices: `quick` (coarse levels, ≤ 10 minutes on 2 cores) and `full`.
+/// The built-in matrices: `quick` (coarse levels, 511 runs, about 18 minutes on 2 cores)
+/// and `full`.
 pub const BUILTIN: [(&str, &str); 2] = [
     ("quick", include_str!("../matrices/quick.toml")),
     ("full", include_str!("../matrices/full.toml")),
