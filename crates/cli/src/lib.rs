@@ -36,6 +36,7 @@ mod error;
 pub mod expression;
 pub mod frame;
 pub mod hydrostatic;
+pub mod jitter;
 mod memory;
 pub mod mesh_info;
 mod output;

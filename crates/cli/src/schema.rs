@@ -762,6 +762,18 @@ pub enum SeedingSpec {
     Mesh(QuadratureSpec),
 }
 
+/// `[[bodies]] jitter`: each lattice-seeded particle moved by a uniform random offset of
+/// up to `amount` × spacing / 2 per axis (`amount` in [0, 1]), from `seed`.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JitterSpec {
+    /// The largest offset per axis as a fraction of half the lattice spacing.
+    pub amount: f64,
+    /// Seed of the offsets (default 0).
+    #[serde(default)]
+    pub seed: u64,
+}
+
 /// `[[bodies]]`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -772,6 +784,8 @@ pub struct BodySpec {
     pub region: Option<RegionSpec>,
     /// Seeding.
     pub seeding: SeedingSpec,
+    /// Random offsets of lattice-seeded particles within their cells.
+    pub jitter: Option<JitterSpec>,
     /// Initial velocity (D components, numbers or expressions in x, y, z); zero if absent.
     pub velocity: Option<Vec<Component>>,
 }

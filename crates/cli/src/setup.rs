@@ -18,6 +18,7 @@ use crate::error::{CliError, Result};
 use crate::expression::{Definitions, VectorField};
 use crate::frame::SceneFrame;
 use crate::hydrostatic::Hydrostatic;
+use crate::jitter::Jitter;
 use crate::probes::ProbeReference;
 use crate::scene::Scene;
 use crate::schema::{
@@ -535,8 +536,37 @@ fn seed_body<const D: usize>(
                 .map_err(|reason| scene.value_error(key("velocity"), reason))?,
         ),
     };
+    let jitter = match (&body.jitter, &body.seeding) {
+        (None, _) => None,
+        (Some(_), SeedingSpec::Mesh(_)) => {
+            return Err(scene.value_error(
+                key("jitter"),
+                "moves lattice-seeded particles; mesh seeding has no lattice",
+            ));
+        }
+        (Some(j), SeedingSpec::Lattice(h) | SeedingSpec::LatticeFrom { spacing: h, .. }) => {
+            if !(0.0..=1.0).contains(&j.amount) {
+                return Err(scene.value_error(
+                    key("jitter.amount"),
+                    format!("is {}; it must be in [0, 1]", j.amount),
+                ));
+            }
+            Some(Jitter::new(j.amount, *h, j.seed))
+        }
+    };
     let before = seeds.position.len();
-    for (x, volume) in samples.iter().filter(|(x, _)| region.contains(x)) {
+    for (i, (x, volume)) in samples
+        .iter()
+        .filter(|(x, _)| region.contains(x))
+        .enumerate()
+    {
+        // Membership was decided at the cell centre; a jittered point the background
+        // does not contain (a non-convex mesh's edge) stays at the centre.
+        let jittered = jitter.map(|j| x + j.offset::<D>(i));
+        let x = match &jittered {
+            Some(y) if background.contains(y) => y,
+            _ => x,
+        };
         let v = match &velocity {
             None => SVector::zeros(),
             Some(field) => field

@@ -416,6 +416,18 @@ fn bad_values_name_their_key() {
             "frames = 61\ninterval = 0.1",
             "`output`",
         ),
+        (
+            "colliding-disks",
+            "seeding = { lattice = 0.025 }",
+            "seeding = { lattice = 0.025 }\njitter = { amount = 1.5 }",
+            "`bodies[0].jitter.amount`",
+        ),
+        (
+            "vortex",
+            "seeding = { lattice = 0.05 }",
+            "seeding = { mesh = \"centroid\" }\njitter = { amount = 0.5 }",
+            "`bodies[0].jitter`",
+        ),
     ] {
         let m = message(scene, find, replace);
         assert!(m.contains(key), "{scene}: `{replace}` gave: {m}");
@@ -466,4 +478,30 @@ fn group_conditions_reach_grid_kernels_as_a_staircase() {
         matches!(&err, CliError::SceneValue { key, .. } if key == "boundaries[0].group"),
         "{err}"
     );
+}
+
+/// `jitter` moves each lattice particle within its cell by at most amount × h / 2 per
+/// axis, keeps the body's particles, volumes and order, and follows its seed.
+#[test]
+fn jitter_moves_lattice_particles_within_their_cells() {
+    let seeds = |replace: &str| {
+        let scene = with("vortex", "seeding = { lattice = 0.05 }", replace);
+        build::<2>(&scene, triangles).unwrap().seeds
+    };
+    let plain = seeds("seeding = { lattice = 0.05 }");
+    let jittered = seeds("seeding = { lattice = 0.05 }\njitter = { amount = 0.5, seed = 3 }");
+    assert_eq!(plain.position.len(), jittered.position.len());
+    assert_eq!(plain.volume, jittered.volume);
+    let largest = plain
+        .position
+        .iter()
+        .zip(&jittered.position)
+        .map(|(a, b)| (a - b).amax())
+        .fold(0.0, f64::max);
+    // The bound is 0.5 × 0.05 / 2; 2520 offset components nearly reach it.
+    assert!(largest <= 0.0125 && largest > 0.012, "{largest}");
+    let other = seeds("seeding = { lattice = 0.05 }\njitter = { amount = 0.5, seed = 4 }");
+    assert_ne!(jittered.position, other.position);
+    let again = seeds("seeding = { lattice = 0.05 }\njitter = { amount = 0.5, seed = 3 }");
+    assert_eq!(jittered.position, again.position);
 }
