@@ -37,20 +37,23 @@ impl Compiled {
     fn eval(&self, values: &[f64]) -> Result<f64, String> {
         // Most expressions read a few variables: a short array to gather them keeps
         // the evaluation from clearing and copying the whole slot range every time
-        // (it was most of a manufactured body force's cost).
-        const SHORT: usize = 8;
-        if self.slots.len() <= SHORT {
-            let mut arguments = [0.0; SHORT];
-            for (a, &s) in arguments.iter_mut().zip(&self.slots) {
-                *a = values[s];
-            }
-            return self
-                .expr
-                .eval(&arguments[..self.slots.len()])
-                .map_err(|e| e.to_string());
+        // (it was most of a manufactured body force's cost). Neither size allocates.
+        if self.slots.len() <= 8 {
+            self.eval_gathered::<8>(values)
+        } else {
+            self.eval_gathered::<{ 4 + MAX_DEFINITIONS }>(values)
         }
-        let arguments: Vec<f64> = self.slots.iter().map(|&s| values[s]).collect();
-        self.expr.eval(&arguments).map_err(|e| e.to_string())
+    }
+
+    /// Evaluates with the variables gathered into an array of `N` ≥ the slot count.
+    fn eval_gathered<const N: usize>(&self, values: &[f64]) -> Result<f64, String> {
+        let mut arguments = [0.0; N];
+        for (a, &s) in arguments.iter_mut().zip(&self.slots) {
+            *a = values[s];
+        }
+        self.expr
+            .eval(&arguments[..self.slots.len()])
+            .map_err(|e| e.to_string())
     }
 }
 
