@@ -9,7 +9,7 @@ use umls_cli::setup::{build, triangles};
 
 #[path = "common/runs.rs"]
 mod runs;
-use runs::{History, metric, options, variant};
+use runs::{History, completed_metric, metric, options, variant};
 
 /// The annulus is a difference of balls; its lattice particles fill its area.
 #[test]
@@ -143,9 +143,7 @@ fn a_reference_body_force_acts_where_each_particle_started() {
 /// `edits` (the run must complete).
 fn bspline2_vortex_error(edits: &[(&str, &str)], name: &str) -> f64 {
     let scene = variant("vortex", edits);
-    let report = run(&scene, &options(name, Some(KernelKind::Bspline2), None)).unwrap();
-    assert_eq!(report.summary["status"], "completed", "{}", report.summary);
-    metric(&report.summary, "displacement_error_max")
+    completed_metric(&scene, name, KernelKind::Bspline2, "displacement_error_max")
 }
 
 /// Quadratic B-splines on the vortex: with the scene's four particles per cell their
@@ -255,10 +253,7 @@ fn a_powered_diminishing_factor_keeps_the_vortex_and_lowers_the_bar_stall() {
     // The metric `key` of `scene` run with `umls-eta4` and with `umls`.
     let both = |scene: &Scene, label: &str, key: &str| {
         let error = |kernel: KernelKind| {
-            let name = format!("{label}-{}", kernel.name());
-            let report = run(scene, &options(&name, Some(kernel), None)).unwrap();
-            assert_eq!(report.summary["status"], "completed", "{}", report.summary);
-            metric(&report.summary, key)
+            completed_metric(scene, &format!("{label}-{}", kernel.name()), kernel, key)
         };
         (error(KernelKind::UmlsEta4), error(KernelKind::Umls))
     };

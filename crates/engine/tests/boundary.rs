@@ -145,12 +145,17 @@ fn block_under(force: umls_engine::BodyForce<2>) -> Simulation<2, Umls2, NeoHook
 /// Δt Σ m_p b(x_p) per step (internal forces cancel).
 #[test]
 fn body_force_fields() {
-    let material = block_material();
-    let free = block_under;
     let mut with_gravity = StepSettings::new(1e-3);
     with_gravity.gravity = Vector2::new(0.0, -G);
-    let mut a = Simulation::new(Umls2::new(slope()), material, Pic, block(), with_gravity).unwrap();
-    let mut b = free(Arc::new(|_, _, _| Vector2::new(0.0, -G)));
+    let mut a = Simulation::new(
+        Umls2::new(slope()),
+        block_material(),
+        Pic,
+        block(),
+        with_gravity,
+    )
+    .unwrap();
+    let mut b = block_under(Arc::new(|_, _, _| Vector2::new(0.0, -G)));
     for _ in 0..5 {
         a.step().unwrap();
         b.step().unwrap();
@@ -179,36 +184,32 @@ fn body_force_fields() {
     let centre = Vector2::new(1.0, 0.5);
     let k = 40.0;
     let trap_at = move |x: Vector2<f64>| (x - centre) * -k;
-    let mut trap = free(Arc::new(move |_, x, _| trap_at(*x)));
-    // Δt Σ m_p b(x_p) of a simulation's particles now.
-    let impulse_at_current = |sim: &Simulation<2, _, _, Pic>| -> Vector2<f64> {
-        let p = sim.particles();
-        p.position
+    let mut trap = block_under(Arc::new(move |_, x, _| trap_at(*x)));
+    // Δt Σ m_p b(x_p) of the particles' masses at these positions.
+    let impulse_at = |positions: &[Vector2<f64>], masses: &[f64]| -> Vector2<f64> {
+        positions
             .iter()
-            .zip(&p.mass)
+            .zip(masses)
             .map(|(x, m)| trap_at(*x) * (m * 1e-3))
             .sum()
     };
     for _ in 0..5 {
-        let impulse = impulse_at_current(&trap);
+        let impulse = impulse_at(&trap.particles().position, &trap.particles().mass);
         step_gives(&mut trap, impulse);
     }
     // The same trap as a field of where each particle started, through its index: the
     // impulse is Δt Σ m_p b(X_p) every step however far the particles have moved.
     let start = block().position;
     let at_start = start.clone();
-    let mut reference = free(Arc::new(move |p, _, _| trap_at(at_start[p])));
-    let impulse: Vector2<f64> = start
-        .iter()
-        .zip(&reference.particles().mass)
-        .map(|(x, m)| trap_at(*x) * (m * 1e-3))
-        .sum();
+    let mut reference = block_under(Arc::new(move |p, _, _| trap_at(at_start[p])));
+    let impulse = impulse_at(&start, &reference.particles().mass);
     for _ in 0..5 {
         step_gives(&mut reference, impulse);
     }
     // The particles have moved, so the field at their current positions would have
     // given another impulse: the index is what made the difference.
-    let current = impulse_at_current(&reference);
+    let p = reference.particles();
+    let current = impulse_at(&p.position, &p.mass);
     assert!(
         (current - impulse).norm() > 1e-9 * impulse.norm(),
         "{current:?} vs {impulse:?}"

@@ -27,6 +27,14 @@ pub fn metric(summary: &serde_json::Value, name: &str) -> f64 {
         .unwrap_or_else(|| panic!("no metric `{name}` in {summary}"))
 }
 
+/// The metric `key` of `scene` run with `kernel` (output under `name`); the run must
+/// complete.
+pub fn completed_metric(scene: &Scene, name: &str, kernel: KernelKind, key: &str) -> f64 {
+    let report = umls_cli::run::run(scene, &options(name, Some(kernel), None)).unwrap();
+    assert_eq!(report.summary["status"], "completed", "{}", report.summary);
+    metric(&report.summary, key)
+}
+
 /// The built-in scene with each `find` replaced by its `replace` (which must occur).
 pub fn variant(name: &str, edits: &[(&str, &str)]) -> Scene {
     let mut text = umls_cli::builtin::BUILTIN
