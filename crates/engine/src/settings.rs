@@ -43,7 +43,9 @@ pub enum Damping {
 
 /// Whether the step stores every particle's stencil (its entries, or the kernel's
 /// factors of it) or evaluates it again where P2G and G2P use it. All give the same
-/// numbers, bit for bit; they trade memory against work.
+/// numbers, bit for bit, except for a tensor-product kernel (B-splines) evaluated again:
+/// P2G and G2P then sum its stencil row by row (`Kernel::tensor_stencil`), which agrees
+/// with its stored entries to round-off. They trade memory against work.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum StencilStorage {
     /// As the kernel prefers: recomputed where `Kernel::recompute_stencils` says so

@@ -25,6 +25,7 @@ mod grid_to_particles;
 mod mass_matrix;
 mod musl;
 mod particles_to_grid;
+mod tensor_rows;
 
 /// A body acceleration b(p, x, t), added to gravity: called with the particle's index p
 /// (its place in [`Simulation::particles`], which the engine never reorders), its

@@ -369,6 +369,13 @@ impl<const D: usize> Stencils<D> {
             .map_err(|e| (p, e))
     }
 
+    /// Whether the stencils are recomputed where they are used (neither entries nor
+    /// factors stored).
+    #[inline]
+    pub fn recomputed(&self) -> bool {
+        self.mode == Mode::Recompute
+    }
+
     /// Whether the stencils are stored as entries ([`Self::visit_entries`] visits them).
     #[inline]
     pub fn stores_entries(&self) -> bool {

@@ -8,7 +8,8 @@ use std::sync::Arc;
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use umls_constitutive::{ElasticParameters, NeoHookean};
 use umls_engine::{
-    Apic, Particles, Region, Simulation, StencilStorage, StepSettings, lattice_samples,
+    Apic, ApicFlip, Flip, MlsMpm, Particles, Pic, Region, Simulation, StencilStorage, StepSettings,
+    TransferScheme, VelocityGradientAffine, lattice_samples,
 };
 use umls_kernels::{BSplineKernel, BSplineOrder, Umls2, Umls3};
 use umls_mesh::generate::{Diagonal, Lattice};
@@ -41,9 +42,21 @@ type State<const D: usize> = (
 );
 
 /// Positions, velocities and deformation gradients after `steps` steps in a pool of
-/// `threads` threads.
+/// `threads` threads, with APIC.
 fn state<const D: usize, K: Kernel<D> + Clone + Send + Sync>(
     kernel: &K,
+    h: f64,
+    steps: usize,
+    threads: usize,
+    storage: StencilStorage,
+) -> State<D> {
+    state_with(kernel, Apic, h, steps, threads, storage)
+}
+
+/// [`state`] with the transfer scheme `transfer`.
+fn state_with<const D: usize, K: Kernel<D> + Clone + Send + Sync, T: TransferScheme>(
+    kernel: &K,
+    transfer: T,
     h: f64,
     steps: usize,
     threads: usize,
@@ -65,7 +78,7 @@ fn state<const D: usize, K: Kernel<D> + Clone + Send + Sync>(
         let mut sim = Simulation::new(
             kernel.clone(),
             material,
-            Apic,
+            transfer,
             particles::<D, K::Cache>(h),
             settings,
         )
@@ -230,7 +243,10 @@ fn three_dimensional_runs_are_bitwise_independent_of_the_thread_count() {
 
 /// Recomputing a stencil where P2G and G2P use it, or rebuilding it from stored factors
 /// (UMLS; the others store entries then), gives the stored stencil's numbers, bit for bit
-/// (APIC reads the offsets x_i − x_p too), for grid and mesh kernels, on 1 and 2 threads.
+/// (APIC reads the offsets x_i − x_p too), for mesh kernels, on 1 and 2 threads.
+/// B-spline stencils that are not stored are summed row by row
+/// (`Kernel::tensor_stencil`), grouped otherwise than the stored entries: see
+/// [`recomputed_b_spline_stencils_agree_with_stored_ones_under_every_transfer`].
 #[test]
 fn stored_factored_and_recomputed_stencils_give_the_same_bits() {
     fn same<const D: usize, K: Kernel<D> + Clone + Send + Sync>(name: &str, kernel: K, h: f64) {
@@ -248,20 +264,6 @@ fn stored_factored_and_recomputed_stencils_give_the_same_bits() {
         // The runs moved the particles: the comparison is not between two rest states.
         assert!(stored.1.iter().any(|v| v.norm() > 0.1), "{name}");
     }
-    let grid2 = BSplineKernel::new(
-        Vector2::new(-0.1, -0.1),
-        0.05,
-        [24, 24],
-        BSplineOrder::Quadratic,
-    );
-    same("bspline2", grid2.unwrap(), 0.0125);
-    let grid3 = BSplineKernel::new(
-        Vector3::from_element(-0.2),
-        0.1,
-        [14, 14, 14],
-        BSplineOrder::Cubic,
-    );
-    same("bspline3 3D", grid3.unwrap(), 0.05);
     let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [16, 16]).jitter(0.2, 5);
     let triangles = Arc::new(mesh.triangles(Diagonal::Alternating).unwrap());
     assert!(Umls2::new(triangles.clone()).factor_layout().is_some());
@@ -284,4 +286,85 @@ fn stored_factored_and_recomputed_stencils_give_the_same_bits() {
         Umls3::new(Arc::new(tets.tetrahedra().unwrap())),
         0.05,
     );
+}
+
+/// B-spline stencils that are not stored are summed row by row along axis 0
+/// (`Kernel::tensor_stencil`): under every transfer scheme, in 2D and 3D, quadratic and
+/// cubic, the particles come out as with the stored entries summed one by one, to
+/// round-off (the sums are grouped otherwise; a wrong factor or gradient component
+/// would show at the size of the motion), and the stored entries still equal the
+/// factored setting's (B-splines have no factors, so it stores entries) bit for bit.
+#[test]
+fn recomputed_b_spline_stencils_agree_with_stored_ones_under_every_transfer() {
+    fn agree<const D: usize, T: TransferScheme + Copy>(
+        name: &str,
+        kernel: &BSplineKernel<D>,
+        transfer: T,
+        h: f64,
+    ) {
+        let stored = state_with(kernel, transfer, h, 12, 1, StencilStorage::Store);
+        let largest = |values: &[f64]| values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let flat = |s: &State<D>| -> [Vec<f64>; 3] {
+            [
+                s.0.iter().flat_map(|v| v.iter().copied()).collect(),
+                s.1.iter().flat_map(|v| v.iter().copied()).collect(),
+                s.2.iter().flat_map(|m| m.iter().copied()).collect(),
+            ]
+        };
+        let reference = flat(&stored);
+        // The runs moved the particles: the comparison is not between two rest states.
+        assert!(stored.1.iter().any(|v| v.norm() > 0.1), "{name}");
+        for threads in [1, 2] {
+            let rows = flat(&state_with(
+                kernel,
+                transfer,
+                h,
+                12,
+                threads,
+                StencilStorage::Recompute,
+            ));
+            for (field, (a, b)) in ["position", "velocity", "deformation"]
+                .iter()
+                .zip(reference.iter().zip(&rows))
+            {
+                let scale = largest(a);
+                let difference = a
+                    .iter()
+                    .zip(b)
+                    .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+                assert!(
+                    difference <= 1e-12 * scale,
+                    "{name}, {threads} threads: {field} differs by {difference:e} (scale {scale:e})"
+                );
+            }
+            assert!(
+                state_with(kernel, transfer, h, 12, threads, StencilStorage::Factored) == stored,
+                "{name}: factored stencils on {threads} threads differ from stored ones"
+            );
+        }
+    }
+    fn every_transfer<const D: usize>(name: &str, kernel: &BSplineKernel<D>, h: f64) {
+        agree(&format!("{name}, PIC"), kernel, Pic, h);
+        agree(&format!("{name}, FLIP"), kernel, Flip { alpha: 0.99 }, h);
+        agree(&format!("{name}, APIC"), kernel, Apic, h);
+        agree(&format!("{name}, MLS-MPM"), kernel, MlsMpm, h);
+        agree(
+            &format!("{name}, APIC-FLIP"),
+            kernel,
+            ApicFlip { alpha: 0.99 },
+            h,
+        );
+        agree(
+            &format!("{name}, velocity-gradient"),
+            kernel,
+            VelocityGradientAffine,
+            h,
+        );
+    }
+    for order in [BSplineOrder::Quadratic, BSplineOrder::Cubic] {
+        let grid2 = BSplineKernel::new(Vector2::new(-0.1, -0.1), 0.05, [24, 24], order);
+        every_transfer(&format!("{order:?} 2D"), &grid2.unwrap(), 0.0125);
+        let grid3 = BSplineKernel::new(Vector3::from_element(-0.2), 0.1, [14, 14, 14], order);
+        every_transfer(&format!("{order:?} 3D"), &grid3.unwrap(), 0.05);
+    }
 }

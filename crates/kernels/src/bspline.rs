@@ -2,7 +2,7 @@
 //! reference of MPM.
 
 use nalgebra::SVector;
-use umls_transfer::{Kernel, KernelError, Stencil};
+use umls_transfer::{Kernel, KernelError, Stencil, TensorStencil};
 
 /// Polynomial order of the B-spline.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -235,6 +235,27 @@ impl<const D: usize> Kernel<D> for BSplineKernel<D> {
         true
     }
 
+    fn tensor_width(&self) -> Option<usize> {
+        Some(self.order.width())
+    }
+
+    #[inline(always)]
+    fn tensor_stencil<const W: usize>(
+        &self,
+        x: &SVector<f64, D>,
+    ) -> Result<TensorStencil<D, W>, KernelError> {
+        match self.order {
+            BSplineOrder::Quadratic if W == 3 => {
+                self.tensor_of_width::<W>(BSplineOrder::Quadratic, x)
+            }
+            BSplineOrder::Cubic if W == 4 => self.tensor_of_width::<W>(BSplineOrder::Cubic, x),
+            _ => Err(KernelError::NotTensorProduct {
+                kernel: std::any::type_name::<Self>(),
+                width: W,
+            }),
+        }
+    }
+
     fn node_range(
         &self,
         x: &SVector<f64, D>,
@@ -280,6 +301,37 @@ impl<const D: usize> Kernel<D> for BSplineKernel<D> {
 }
 
 impl<const D: usize> BSplineKernel<D> {
+    /// The stencil at `x` as per-axis factors, for `order` (this kernel's), whose stencil
+    /// is `W` nodes wide per axis. Each offset is computed as node_position(i) − x would
+    /// be, so both agree bit for bit.
+    #[inline(always)]
+    fn tensor_of_width<const W: usize>(
+        &self,
+        order: BSplineOrder,
+        x: &SVector<f64, D>,
+    ) -> Result<TensorStencil<D, W>, KernelError> {
+        debug_assert!(order == self.order && W == order.width());
+        let base = self.base_nodes_of(order, x)?;
+        let mut tensor = TensorStencil {
+            first: self.node_index(base),
+            strides: self.strides(),
+            values: [[0.0; W]; D],
+            derivatives: [[0.0; W]; D],
+            offsets: [[0.0; W]; D],
+        };
+        for k in 0..D {
+            let xi = (x[k] - self.origin[k]) / self.h;
+            for a in 0..W {
+                let node = (base[k] + a) as f64;
+                let (value, derivative) = order.weight(xi - node);
+                tensor.values[k][a] = value;
+                tensor.derivatives[k][a] = derivative / self.h;
+                tensor.offsets[k][a] = self.origin[k] + self.h * node - x[k];
+            }
+        }
+        Ok(tensor)
+    }
+
     /// The stencil at `x`, entry by entry: `visit(node, N, ∇N, x_node − x)` with nodes
     /// in index order (rows along axis 0, the numbering's fastest axis). One body for
     /// [`Kernel::stencil`] and [`Kernel::visit_stencil`], so both give the same bits.
@@ -311,25 +363,13 @@ impl<const D: usize> BSplineKernel<D> {
     where
         F: FnMut(u32, f64, &SVector<f64, D>, &SVector<f64, D>),
     {
-        debug_assert!(order == self.order && W == order.width());
-        let base = self.base_nodes_of(order, x)?;
-        // Per axis: weights, derivatives and offsets x_i − x of the `W` nodes. The
-        // offset is computed as node_position(i) − x would be, so both agree bit for bit.
-        let mut w = [[0.0; W]; D];
-        let mut dw = [[0.0; W]; D];
-        let mut r = [[0.0; W]; D];
-        for k in 0..D {
-            let xi = (x[k] - self.origin[k]) / self.h;
-            for a in 0..W {
-                let node = (base[k] + a) as f64;
-                let (value, derivative) = order.weight(xi - node);
-                w[k][a] = value;
-                dw[k][a] = derivative / self.h;
-                r[k][a] = self.origin[k] + self.h * node - x[k];
-            }
-        }
-        let strides = self.strides();
-        let first = self.node_index(base);
+        let TensorStencil {
+            first,
+            strides,
+            values: w,
+            derivatives: dw,
+            offsets: r,
+        } = self.tensor_of_width::<W>(order, x)?;
         // The factors are multiplied in axis order, as N = Π_k w_k reads (regrouping
         // them would change the last bit of the results).
         let mut digits = [0usize; D];

@@ -9,7 +9,9 @@
 //!   with cell-crossing error (feature `mesh`);
 //! - [`BSplineKernel`]: quadratic or cubic B-splines on a Cartesian grid, the
 //!   structured-grid reference (always; with `default-features = false` the crate is
-//!   this alone, without the mesh crate and parry).
+//!   this alone, without the mesh crate and parry). Its stencils are tensor products,
+//!   which it also hands over as per-axis factors (`Kernel::tensor_stencil`) for
+//!   transfers that sum them row by row.
 //!
 //! Every kernel passes the same conformance suite (`testing::check_kernel`, public with
 //! the feature `testing` so that a kernel written elsewhere can run it too): partition

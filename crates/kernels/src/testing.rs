@@ -20,6 +20,9 @@
 //! - factored stencils (`Kernel::factor_layout`) of the declared layout, rebuilt by
 //!   `Kernel::visit_factored` into the stencil's entries, with its node range; and
 //!   `KernelError::NotFactored` from a kernel without a layout;
+//! - tensor-product stencils (`Kernel::tensor_width`, widths 1 to 6) whose per-axis
+//!   factors give the stencil's nodes, values, gradients and offsets bit for bit (as
+//!   products in axis order), and `KernelError::NotTensorProduct` for any other width;
 //! - a typed `KernelError::OutsideDomain` far outside.
 //!
 //! ```
@@ -32,7 +35,7 @@
 //! ```
 
 use nalgebra::{SMatrix, SVector};
-use umls_transfer::{Kernel, KernelError, Stencil};
+use umls_transfer::{Kernel, KernelError, Stencil, TensorStencil};
 
 /// Tolerances of the suite, relative to the kernel's spacing where lengths enter.
 const UNITY: f64 = 1e-12;
@@ -156,6 +159,7 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
         }
         check_appended(kernel, x, &st).map_err(fail)?;
         check_factors(kernel, x, &st).map_err(fail)?;
+        check_tensor(kernel, x, &st).map_err(fail)?;
     }
     let outside_error = |what: &str, got: String| Violation {
         point: outside.iter().copied().collect(),
@@ -281,6 +285,96 @@ fn check_factors<const D: usize, K: Kernel<D>>(
         .map_err(|e| format!("visit_factored fails inside the domain: {e}"))?;
     if &rebuilt != st {
         return Err("visit_factored rebuilds other entries than stencil gives".into());
+    }
+    Ok(())
+}
+
+/// The tensor-product checks at `x`, whose stencil is `st`: the factors of the declared
+/// width rebuild it, every other width (1 to 6) is refused.
+fn check_tensor<const D: usize, K: Kernel<D>>(
+    kernel: &K,
+    x: &SVector<f64, D>,
+    st: &Stencil<D>,
+) -> Result<(), String> {
+    let declared = kernel.tensor_width();
+    let mut outcomes = [
+        tensor_of_width::<D, K, 1>(kernel, x, st, declared),
+        tensor_of_width::<D, K, 2>(kernel, x, st, declared),
+        tensor_of_width::<D, K, 3>(kernel, x, st, declared),
+        tensor_of_width::<D, K, 4>(kernel, x, st, declared),
+        tensor_of_width::<D, K, 5>(kernel, x, st, declared),
+        tensor_of_width::<D, K, 6>(kernel, x, st, declared),
+    ]
+    .into_iter();
+    if let Some(w) = declared.filter(|w| !(1..=6).contains(w)) {
+        return Err(format!("tensor width {w}: the suite checks widths 1 to 6"));
+    }
+    outcomes.try_for_each(|outcome| outcome)
+}
+
+/// [`check_tensor`] for the width `W`.
+// The axis index runs over several per-axis arrays at once.
+#[allow(clippy::needless_range_loop)]
+fn tensor_of_width<const D: usize, K: Kernel<D>, const W: usize>(
+    kernel: &K,
+    x: &SVector<f64, D>,
+    st: &Stencil<D>,
+    declared: Option<usize>,
+) -> Result<(), String> {
+    let result = kernel.tensor_stencil::<W>(x);
+    if declared != Some(W) {
+        return match result {
+            Err(KernelError::NotTensorProduct { width, .. }) if width == W => Ok(()),
+            other => Err(format!(
+                "tensor_stencil of width {W} (declared {declared:?}) gives {other:?}, not \
+                 NotTensorProduct"
+            )),
+        };
+    }
+    let t: TensorStencil<D, W> =
+        result.map_err(|e| format!("tensor_stencil fails inside the domain: {e}"))?;
+    let mut rebuilt = Stencil::new();
+    let mut digits = [0usize; D];
+    'entries: loop {
+        let node = t.first + (0..D).map(|k| digits[k] * t.strides[k]).sum::<usize>();
+        let mut value = t.values[0][digits[0]];
+        for k in 1..D {
+            value *= t.values[k][digits[k]];
+        }
+        let gradient = SVector::<f64, D>::from_fn(|j, _| {
+            let mut g = if j == 0 {
+                t.derivatives[0][digits[0]]
+            } else {
+                t.values[0][digits[0]]
+            };
+            for k in 1..D {
+                g *= if k == j {
+                    t.derivatives[k][digits[k]]
+                } else {
+                    t.values[k][digits[k]]
+                };
+            }
+            g
+        });
+        let offset = SVector::<f64, D>::from_fn(|k, _| t.offsets[k][digits[k]]);
+        let Ok(node) = u32::try_from(node) else {
+            return Err(format!("tensor_stencil gives node {node}, beyond u32"));
+        };
+        rebuilt.push(node, value, gradient, offset);
+        // Axis 0 fastest, as the stencil's node numbering runs.
+        for digit in digits.iter_mut() {
+            *digit += 1;
+            if *digit < W {
+                continue 'entries;
+            }
+            *digit = 0;
+        }
+        break;
+    }
+    if &rebuilt != st {
+        return Err(format!(
+            "tensor_stencil's factors of width {W} rebuild other entries than stencil gives"
+        ));
     }
     Ok(())
 }

@@ -5,7 +5,9 @@
 //! gradients ∇N_i. Each particle keeps a small [`Kernel::Cache`] (its host simplex or
 //! cell) so that relocating a particle that moved a little costs O(1). Transfers (P2G,
 //! G2P) and the engine see only this trait, so swapping UMLS for linear FE or B-splines
-//! changes one type.
+//! changes one type. A kernel whose stencils are tensor products of per-axis factors
+//! (B-splines) may also hand those over ([`Kernel::tensor_stencil`], a
+//! [`TensorStencil`]), so that transfers can sum a stencil row by row.
 //!
 //! ```
 //! use nalgebra::SVector;
@@ -33,6 +35,7 @@
 //! ```
 
 mod stencil;
+mod tensor;
 
 use std::sync::Arc;
 
@@ -40,6 +43,7 @@ use nalgebra::SVector;
 use thiserror::Error;
 
 pub use stencil::{EntriesMut, Stencil, node_range};
+pub use tensor::TensorStencil;
 
 /// Why a kernel could not produce a stencil.
 #[derive(Debug, Clone, Error)]
@@ -56,6 +60,15 @@ pub enum KernelError {
     NotFactored {
         /// The kernel's name (its type).
         kernel: &'static str,
+    },
+    /// The engine asked for a kernel's stencil as per-axis factors of a width
+    /// ([`Kernel::tensor_stencil`]) other than its [`Kernel::tensor_width`].
+    #[error("{kernel} kernel has no tensor-product stencils {width} nodes wide")]
+    NotTensorProduct {
+        /// The kernel's name (its type).
+        kernel: &'static str,
+        /// The width asked for.
+        width: usize,
     },
     /// The kernel's own evaluation failed (an MLS moment matrix that is ill-conditioned,
     /// …): the kernel names itself, and the cause is its own error type, which
@@ -89,6 +102,16 @@ impl PartialEq for KernelError {
         match (self, other) {
             (Self::OutsideDomain { point: a }, Self::OutsideDomain { point: b }) => a == b,
             (Self::NotFactored { kernel: a }, Self::NotFactored { kernel: b }) => a == b,
+            (
+                Self::NotTensorProduct {
+                    kernel: a,
+                    width: w,
+                },
+                Self::NotTensorProduct {
+                    kernel: b,
+                    width: v,
+                },
+            ) => a == b && w == v,
             (
                 Self::Evaluation {
                     kernel: a,
@@ -206,6 +229,28 @@ pub trait Kernel<const D: usize>: Send + Sync {
             visit(node, value, gradient, &offsets[e]);
         }
         Ok(())
+    }
+
+    /// `Some(W)` if every stencil of the kernel is the tensor product of `W` nodes per
+    /// axis that [`Self::tensor_stencil`] gives as per-axis factors (a B-spline grid), so
+    /// that transfers may sum it row by row; `None` (the default) otherwise.
+    fn tensor_width(&self) -> Option<usize> {
+        None
+    }
+
+    /// The stencil at `x` as per-axis factors, for a kernel whose [`Self::tensor_width`]
+    /// is `Some(W)`: the entries of [`Self::stencil`] (N and ∇N as the factors' products
+    /// in axis order give them), failing where it fails. The default, like a kernel asked
+    /// for another width, fails with [`KernelError::NotTensorProduct`].
+    fn tensor_stencil<const W: usize>(
+        &self,
+        x: &SVector<f64, D>,
+    ) -> Result<TensorStencil<D, W>, KernelError> {
+        let _ = x;
+        Err(KernelError::NotTensorProduct {
+            kernel: std::any::type_name::<Self>(),
+            width: W,
+        })
     }
 
     /// The smallest and largest node index of the stencil at `x` (the engine orders

@@ -7,6 +7,7 @@ use umls_constitutive::Constitutive;
 use umls_transfer::{Kernel, KernelError, Stencil};
 
 use super::Simulation;
+use super::tensor_rows::gather_rows;
 use crate::boundary::Boundary;
 use crate::error::EngineError;
 use crate::parallel::lowest_failure;
@@ -105,7 +106,32 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
     // Stored entries get sums of their own, which no kernel call takes: they stay in
     // registers (through `visit`, whose other modes pass the sink to the kernel, they
     // were reloaded from memory at every entry).
-    let sums = if stencils.stores_entries() {
+    // A tensor-product stencil that is not stored is summed row by row, where D_p is
+    // constant or unused.
+    let tensor_width = kernel.tensor_width().filter(|&w| {
+        (w == 3 || w == 4) && stencils.recomputed() && (moment_scale.is_some() || !T::AFFINE)
+    });
+    let sums = if let Some(width) = tensor_width {
+        let (pic, flip, grad_v, b) = match width {
+            3 => gather_rows::<D, 3, T>(
+                &kernel.tensor_stencil::<3>(&x).map_err(|e| (p, e))?,
+                grid.new,
+                grid.old,
+            ),
+            _ => gather_rows::<D, 4, T>(
+                &kernel.tensor_stencil::<4>(&x).map_err(|e| (p, e))?,
+                grid.new,
+                grid.old,
+            ),
+        };
+        GatherSums {
+            pic,
+            flip,
+            grad_v,
+            b,
+            ..new_sums()
+        }
+    } else if stencils.stores_entries() {
         let mut sums = new_sums();
         stencils.visit_entries(p, kernel, &x, offsets, &mut sums);
         sums

@@ -7,6 +7,7 @@ use umls_constitutive::Constitutive;
 use umls_transfer::{Kernel, Stencil};
 
 use super::Simulation;
+use super::tensor_rows::{ParticleLoad, scatter_rows};
 use crate::error::EngineError;
 use crate::scatter::Window;
 use crate::stencils::{EntrySink, correction_mean, second_moment};
@@ -138,6 +139,16 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let dt = self.dt;
         let ranges = stencils.ranges();
         let correction = kernel.force_gradient_correction().filter(|_| CORRECTED);
+        // A tensor-product stencil that is not stored is summed row by row
+        // ([`scatter_rows`]), where no entry-wise correction, |N|-mass or limiter needs
+        // the entries one by one.
+        let tensor_width = kernel.tensor_width().filter(|&w| {
+            (w == 3 || w == 4)
+                && A == 0
+                && !CORRECTED
+                && !(T::AFFINE && varying_moment)
+                && stencils.recomputed()
+        });
         self.scatter
             .scatter(ranges, sums, |block, window| {
                 let mut scratch = Stencil::new();
@@ -182,7 +193,27 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     } else if T::AFFINE && !limiter_reads {
                         sink.affine = p.affine[i];
                     }
-                    if limiter_reads || mean_reads {
+                    if let Some(width) = tensor_width {
+                        let load = ParticleLoad {
+                            mass: m,
+                            velocity: sink.velocity,
+                            affine: sink.affine,
+                            volume,
+                            stress_volume,
+                            acceleration,
+                        };
+                        let window = &mut *sink.window;
+                        match width {
+                            3 => {
+                                let t = kernel.tensor_stencil::<3>(&x).map_err(|e| (i, e))?;
+                                scatter_rows::<D, 3, T>(&t, window, &load);
+                            }
+                            _ => {
+                                let t = kernel.tensor_stencil::<4>(&x).map_err(|e| (i, e))?;
+                                scatter_rows::<D, 4, T>(&t, window, &load);
+                            }
+                        }
+                    } else if limiter_reads || mean_reads {
                         // One evaluation serves the whole-stencil sums and the entries.
                         stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
                             if let Some(xi) = correction.filter(|_| mean_reads) {
