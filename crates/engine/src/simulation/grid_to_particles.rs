@@ -103,11 +103,10 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
         },
         transfer: std::marker::PhantomData,
     };
-    // Stored entries get sums of their own, which no kernel call takes: they stay in
-    // registers (through `visit`, whose other modes pass the sink to the kernel, they
-    // were reloaded from memory at every entry).
     // A tensor-product stencil that is not stored is summed row by row, where D_p is
-    // constant or unused.
+    // constant or unused. Stored entries get sums of their own, which no kernel call
+    // takes: they stay in registers (through `visit`, whose other modes pass the sink
+    // to the kernel, they were reloaded from memory at every entry).
     let tensor_width = kernel.tensor_width().filter(|&w| {
         (w == 3 || w == 4) && stencils.recomputed() && (moment_scale.is_some() || !T::AFFINE)
     });
