@@ -7,7 +7,7 @@ use umls_constitutive::Constitutive;
 use umls_transfer::{Kernel, KernelError, Stencil};
 
 use super::Simulation;
-use super::tensor_rows::gather_rows;
+use super::tensor_rows::{gather_rows, row_width};
 use crate::boundary::Boundary;
 use crate::error::EngineError;
 use crate::parallel::lowest_failure;
@@ -107,9 +107,8 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
     // constant or unused. Stored entries get sums of their own, which no kernel call
     // takes: they stay in registers (through `visit`, whose other modes pass the sink
     // to the kernel, they were reloaded from memory at every entry).
-    let tensor_width = kernel.tensor_width().filter(|&w| {
-        (w == 3 || w == 4) && stencils.recomputed() && (moment_scale.is_some() || !T::AFFINE)
-    });
+    let tensor_width = row_width(kernel)
+        .filter(|_| stencils.recomputed() && (moment_scale.is_some() || !T::AFFINE));
     let sums = if let Some(width) = tensor_width {
         let (pic, flip, grad_v, b) = match width {
             3 => gather_rows::<D, 3, T>(

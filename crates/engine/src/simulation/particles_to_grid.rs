@@ -7,7 +7,7 @@ use umls_constitutive::Constitutive;
 use umls_transfer::{Kernel, Stencil};
 
 use super::Simulation;
-use super::tensor_rows::{ParticleLoad, scatter_rows};
+use super::tensor_rows::{ParticleLoad, row_width, scatter_rows};
 use crate::error::EngineError;
 use crate::scatter::Window;
 use crate::stencils::{EntrySink, correction_mean, second_moment};
@@ -43,14 +43,8 @@ fn limited_affine<const D: usize>(
 /// 0 for a kernel whose values are never negative (no |N|-mass summed), else 1.
 struct ScatterEntry<'w, const D: usize, T, const CORRECTED: bool, const A: usize> {
     window: &'w mut Window<D>,
-    /// The affine matrix P2G spreads (zero without an affine transfer).
-    affine: SMatrix<f64, D, D>,
-    mass: f64,
-    velocity: SVector<f64, D>,
-    volume: f64,
-    /// Kirchhoff stress times the current volume.
-    stress_volume: SMatrix<f64, D, D>,
-    acceleration: SVector<f64, D>,
+    /// What the particle spreads (the affine matrix zero without an affine transfer).
+    load: ParticleLoad<D>,
     /// The kernel's integration correction ξ_i per node (empty unless `CORRECTED`): the
     /// force's gradient is ∇N_i + N_i (ξ_i − ξ̄_p) ([`Kernel::force_gradient_correction`]).
     correction: &'w [SVector<f64, D>],
@@ -65,17 +59,17 @@ impl<const D: usize, T: TransferScheme, const CORRECTED: bool, const A: usize> E
 {
     #[inline(always)]
     fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, r: &SVector<f64, D>) {
-        let m = self.mass;
+        let m = self.load.mass;
         if T::FUSED_FORCE {
             // `velocity` is m (v + Δt a) and `affine` m C − Δt V τ D⁻¹ here.
-            let momentum = self.velocity + self.affine * r;
+            let momentum = self.load.velocity + self.load.affine * r;
             self.window
                 .add_momentum::<A>(node as usize, n * m, n.abs() * m, momentum * n);
             return;
         }
-        let mut mv = self.velocity;
+        let mut mv = self.load.velocity;
         if T::AFFINE {
-            mv += self.affine * r;
+            mv += self.load.affine * r;
         }
         let corrected;
         let gradient = if CORRECTED {
@@ -88,9 +82,9 @@ impl<const D: usize, T: TransferScheme, const CORRECTED: bool, const A: usize> E
             node as usize,
             n * m,
             n.abs() * m,
-            self.volume * gradient.norm_squared(),
+            self.load.volume * gradient.norm_squared(),
             mv * (n * m),
-            self.acceleration * (n * m) - self.stress_volume * gradient,
+            self.load.acceleration * (n * m) - self.load.stress_volume * gradient,
         );
     }
 }
@@ -142,12 +136,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // A tensor-product stencil that is not stored is summed row by row
         // ([`scatter_rows`]), where no entry-wise correction, |N|-mass or limiter needs
         // the entries one by one.
-        let tensor_width = kernel.tensor_width().filter(|&w| {
-            (w == 3 || w == 4)
-                && A == 0
-                && !CORRECTED
-                && !(T::AFFINE && varying_moment)
-                && stencils.recomputed()
+        let tensor_width = row_width(kernel).filter(|_| {
+            A == 0 && !CORRECTED && !(T::AFFINE && varying_moment) && stencils.recomputed()
         });
         self.scatter
             .scatter(ranges, sums, |block, window| {
@@ -161,12 +151,14 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         gravity + body.get(i).copied().unwrap_or_else(SVector::zeros);
                     let mut sink = ScatterEntry::<D, T, CORRECTED, A> {
                         window,
-                        affine: SMatrix::zeros(),
-                        mass: m,
-                        velocity: v,
-                        volume,
-                        stress_volume,
-                        acceleration,
+                        load: ParticleLoad {
+                            mass: m,
+                            velocity: v,
+                            affine: SMatrix::zeros(),
+                            volume,
+                            stress_volume,
+                            acceleration,
+                        },
                         correction: correction.unwrap_or(&[]),
                         correction_mean: SVector::zeros(),
                         transfer: std::marker::PhantomData::<T>,
@@ -184,33 +176,25 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         // MLS-MPM: ∇N_i ≈ D⁻¹ N_i r_i folds the stress impulse into the
                         // affine term, and gravity into the momentum.
                         let inverse_moment = 1.0 / constant_moment;
-                        sink.affine = p.affine[i] * m - stress_volume * (dt * inverse_moment);
-                        sink.velocity = (v + acceleration * dt) * m;
+                        sink.load.affine = p.affine[i] * m - stress_volume * (dt * inverse_moment);
+                        sink.load.velocity = (v + acceleration * dt) * m;
                     } else if let Some(d) = stored_moment.filter(|_| T::AFFINE) {
                         // D_p summed with the stencil ([`Stencils::compute`]): the entries
                         // are visited once.
-                        sink.affine = limited_affine(&p.affine[i], p.affine_moment[i], || *d);
+                        sink.load.affine = limited_affine(&p.affine[i], p.affine_moment[i], || *d);
                     } else if T::AFFINE && !limiter_reads {
-                        sink.affine = p.affine[i];
+                        sink.load.affine = p.affine[i];
                     }
                     if let Some(width) = tensor_width {
-                        let load = ParticleLoad {
-                            mass: m,
-                            velocity: sink.velocity,
-                            affine: sink.affine,
-                            volume,
-                            stress_volume,
-                            acceleration,
-                        };
-                        let window = &mut *sink.window;
+                        let (window, load) = (&mut *sink.window, &sink.load);
                         match width {
                             3 => {
                                 let t = kernel.tensor_stencil::<3>(&x).map_err(|e| (i, e))?;
-                                scatter_rows::<D, 3, T>(&t, window, &load);
+                                scatter_rows::<D, 3, T>(&t, window, load);
                             }
                             _ => {
                                 let t = kernel.tensor_stencil::<4>(&x).map_err(|e| (i, e))?;
-                                scatter_rows::<D, 4, T>(&t, window, &load);
+                                scatter_rows::<D, 4, T>(&t, window, load);
                             }
                         }
                     } else if limiter_reads || mean_reads {
@@ -220,7 +204,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                 sink.correction_mean = correction_mean(&st, xi);
                             }
                             if limiter_reads {
-                                sink.affine =
+                                sink.load.affine =
                                     limited_affine(&p.affine[i], p.affine_moment[i], || {
                                         second_moment(&st, kernel, &x)
                                     });

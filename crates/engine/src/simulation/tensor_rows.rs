@@ -11,10 +11,17 @@
 //! loops, so results agree with those to round-off, not bit for bit.
 
 use nalgebra::{SMatrix, SVector};
-use umls_transfer::TensorStencil;
+use umls_transfer::{Kernel, TensorStencil};
 
 use crate::scatter::Window;
 use crate::transfer::TransferScheme;
+
+/// The width of `kernel`'s tensor-product stencils where P2G and G2P sum them row by row:
+/// 3 or 4 nodes per axis (quadratic and cubic B-splines), the widths they dispatch on.
+#[inline]
+pub(super) fn row_width<const D: usize, K: Kernel<D>>(kernel: &K) -> Option<usize> {
+    kernel.tensor_width().filter(|w| matches!(w, 3 | 4))
+}
 
 /// Advances `digits` (the row's node along each axis 1..D) to the next row; false after
 /// the last.
