@@ -13,7 +13,7 @@
 //! the same way through the kernel: a particle that left the mesh through a boundary
 //! facet whose nodes all carry a condition is put back on that facet.
 
-use crate::scatter::NODE_CHUNK;
+use crate::scatter::{LIVE_SEGMENT, NODE_CHUNK, SEGMENTS_PER_CHUNK};
 use nalgebra::SVector;
 use rayon::prelude::*;
 use umls_transfer::{DomainExit, Kernel};
@@ -193,7 +193,8 @@ impl<const D: usize> Boundary<D> {
         }
     }
 
-    /// [`Self::apply`] in parallel over the chunks of [`NODE_CHUNK`] nodes marked `live`;
+    /// [`Self::apply`] in parallel over the chunks of [`NODE_CHUNK`] nodes with a
+    /// segment marked `live` (per [`LIVE_SEGMENT`] nodes), on the nodes of live segments;
     /// the others hold zero velocities, which every condition keeps. Needs
     /// [`Self::sort_by_node`]. Each node sees its conditions in the same order as
     /// under [`Self::apply`] (fixed first, then its slip normals), so the result is the
@@ -201,22 +202,25 @@ impl<const D: usize> Boundary<D> {
     pub(crate) fn apply_live(&self, velocity: &mut [SVector<f64, D>], live: &[bool]) {
         velocity
             .par_chunks_mut(NODE_CHUNK)
-            .zip(live.par_iter())
+            .zip(live.par_chunks(SEGMENTS_PER_CHUNK))
             .enumerate()
-            .for_each(|(c, (chunk, &live))| {
-                if !live {
+            .for_each(|(c, (chunk, live))| {
+                if !live.iter().any(|&l| l) {
                     return;
                 }
                 let start = (c * NODE_CHUNK) as u32;
                 let end = start + chunk.len() as u32;
                 let fixed = &self.fixed[self.fixed.partition_point(|&n| n < start)
                     ..self.fixed.partition_point(|&n| n < end)];
-                for &node in fixed {
+                // Nodes of segments not live are zero and stay so: skipping them spares
+                // the cache misses of a wall's nodes far from the body.
+                let live_node = |node: u32| live[(node - start) as usize / LIVE_SEGMENT];
+                for &node in fixed.iter().filter(|&&n| live_node(n)) {
                     chunk[(node - start) as usize] = SVector::zeros();
                 }
                 let slip = &self.slip[self.slip.partition_point(|(n, _)| *n < start)
                     ..self.slip.partition_point(|(n, _)| *n < end)];
-                for (node, normal) in slip {
+                for (node, normal) in slip.iter().filter(|(n, _)| live_node(*n)) {
                     let v = &mut chunk[(node - start) as usize];
                     let vn = v.dot(normal);
                     if !self.separate || vn < 0.0 {
@@ -319,10 +323,18 @@ mod tests {
             seed ^= seed << 17;
             seed
         };
-        let live: Vec<bool> = (0..nodes.div_ceil(NODE_CHUNK)).map(|c| c != 2).collect();
+        let segment = crate::scatter::LIVE_SEGMENT;
+        // Chunk 2 wholly dead; in chunk 4 only its second segment is live.
+        let live: Vec<bool> = (0..crate::scatter::live_segments(nodes))
+            .map(|s| match s / SEGMENTS_PER_CHUNK {
+                2 => false,
+                4 => s % SEGMENTS_PER_CHUNK == 1,
+                _ => true,
+            })
+            .collect();
         let velocity: Vec<Vector3<f64>> = (0..nodes)
             .map(|i| {
-                if live[i / NODE_CHUNK] {
+                if live[i / segment] {
                     Vector3::new(
                         (next() % 2001) as f64 / 1000.0 - 1.0,
                         (next() % 2001) as f64 / 1000.0 - 1.0,

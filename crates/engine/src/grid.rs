@@ -36,7 +36,7 @@ use nalgebra::SVector;
 use rayon::prelude::*;
 
 use crate::boundary::Boundary;
-use crate::scatter::NODE_CHUNK;
+use crate::scatter::{LIVE_SEGMENT, NODE_CHUNK, SEGMENTS_PER_CHUNK, live_segments};
 use crate::settings::Damping;
 
 /// Nodal fields of one step.
@@ -65,10 +65,10 @@ pub(crate) struct Grid<const D: usize> {
     /// ṽ_i = v_i + Δt f_i / m_i (Δt f_i / Δt² k_i on mass-scaled nodes), plus the
     /// redistributed impulse, with boundary conditions.
     pub new_velocity: Vec<SVector<f64, D>>,
-    /// Per chunk of [`NODE_CHUNK`] nodes: whether it may hold non-zero values this step.
-    /// The others hold zeros in every field (every writer leaves a node without mass at
-    /// zero), so P2G's merge and the grid update skip them: a body in a large box of
-    /// empty nodes does not pay for the box.
+    /// Per segment of [`LIVE_SEGMENT`] nodes: whether it may hold non-zero values this
+    /// step. The others hold zeros in every field (every writer leaves a node without
+    /// mass at zero), so P2G's merge and the grid update skip them: a body in a large box
+    /// of empty nodes does not pay for the box.
     pub live: Vec<bool>,
     /// Contributions below this mass are round-off (10⁻¹² of the heaviest particle).
     pub round_off_mass: f64,
@@ -173,7 +173,7 @@ impl<const D: usize> Grid<D> {
             stiffness: vec![0.0; nodes],
             velocity: vec![SVector::zeros(); nodes],
             new_velocity: vec![SVector::zeros(); nodes],
-            live: vec![false; nodes.div_ceil(NODE_CHUNK)],
+            live: vec![false; live_segments(nodes)],
         }
     }
 
@@ -193,15 +193,15 @@ impl<const D: usize> Grid<D> {
         )
     }
 
-    /// The lowest node whose updated velocity is not finite. Only chunks marked live can
-    /// hold anything but zeros, so only they are read, in parallel; the lowest chunk's
-    /// first such node is the lowest overall, whatever the thread count.
+    /// The lowest node whose updated velocity is not finite. Only chunks with a live
+    /// segment can hold anything but zeros, so only they are read, in parallel; the
+    /// lowest chunk's first such node is the lowest overall, whatever the thread count.
     pub fn first_non_finite_velocity(&self) -> Option<usize> {
         self.new_velocity
             .par_chunks(NODE_CHUNK)
-            .zip(self.live.par_iter())
+            .zip(self.live.par_chunks(SEGMENTS_PER_CHUNK))
             .enumerate()
-            .filter(|(_, (_, live))| **live)
+            .filter(|(_, (_, live))| live.iter().any(|&l| l))
             .find_map_first(|(c, (chunk, _))| {
                 chunk
                     .iter()
@@ -262,17 +262,24 @@ impl<const D: usize> Grid<D> {
             .zip(self.stiffness.par_chunks(NODE_CHUNK))
             .zip(self.velocity.par_chunks_mut(NODE_CHUNK))
             .zip(self.new_velocity.par_chunks_mut(NODE_CHUNK))
-            .zip(self.live.par_iter())
+            .zip(self.live.par_chunks(SEGMENTS_PER_CHUNK))
             .map(
                 |(
                     ((((((mass, abs_mass), momentum), force), stiffness), velocity), new_velocity),
-                    &live,
+                    live,
                 )| {
                     let (mut dropped, mut redistributed, mut scaled, mut active) =
                         (0.0, SVector::<f64, D>::zeros(), 0usize, 0.0);
-                    // A chunk no particle reached, now or in the last step, is zero.
-                    let nodes = if live { mass.len() } else { 0 };
-                    for i in 0..nodes {
+                    // A segment no particle reached, now or in the last step, is zero
+                    // (its nodes would add zeros to the sums).
+                    let live_nodes =
+                        live.iter()
+                            .enumerate()
+                            .filter(|(_, l)| **l)
+                            .flat_map(|(s, _)| {
+                                s * LIVE_SEGMENT..mass.len().min((s + 1) * LIVE_SEGMENT)
+                            });
+                    for i in live_nodes {
                         let m = mass[i];
                         // The zero arrays of a momentum-only scatter are not read: the
                         // same values, less memory traffic.

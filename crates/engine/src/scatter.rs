@@ -3,10 +3,15 @@
 //! Particles are ordered by the lowest node of their stencil (ties by index), so that
 //! consecutive particles touch neighbouring nodes, and cut into blocks of [`BLOCK`]
 //! particles. Each block scatters into its own *window*: dense arrays over the node
-//! indices `lo..hi` its particles touch, which for a lattice numbering is the block's few
-//! cells plus the stencil's reach, not the whole grid. Blocks run in parallel; then
-//! every node sums the windows that cover it in block order, in parallel over chunks of
-//! nodes.
+//! indices `lo..hi` its particles touch, or, where the kernel numbers its nodes on a
+//! lattice ([`Lattice`]), over the box of the lattice they touch. Blocks run in parallel;
+//! then every node sums the windows that cover it in block order, in parallel over
+//! chunks of nodes.
+//!
+//! Why boxes: in 3D a block of particles spans a few planes of cells, and the index range
+//! of those planes holds every node of them, most of which no particle of the block
+//! reaches (in the 64³ fluid box, 17,000 nodes per window against some 4,000 in the
+//! block's box). Clearing and merging the range moved that much memory every step.
 //!
 //! The blocks depend on the particle count and positions only, and each node's sum runs
 //! in block order, so the result is bitwise the same on any number of threads. Where a
@@ -140,6 +145,26 @@ struct ChunkSums<'a, const D: usize> {
     force: &'a mut [SVector<f64, D>],
 }
 
+impl<const D: usize> ChunkSums<'_, D> {
+    /// The nodes `range` of the chunk (the arrays a layout leaves empty stay empty).
+    fn part(&mut self, range: std::ops::Range<usize>) -> ChunkSums<'_, D> {
+        fn slice<'s, T>(a: &'s mut [T], range: &std::ops::Range<usize>) -> &'s mut [T] {
+            if a.is_empty() {
+                a
+            } else {
+                &mut a[range.clone()]
+            }
+        }
+        ChunkSums {
+            mass: slice(self.mass, &range),
+            abs_mass: slice(self.abs_mass, &range),
+            stiffness: slice(self.stiffness, &range),
+            momentum: slice(self.momentum, &range),
+            force: slice(self.force, &range),
+        }
+    }
+}
+
 impl<const D: usize, const A: usize> Record<D> for NodeSums<D, A>
 where
     Self: InWindow<D>,
@@ -186,24 +211,170 @@ where
     }
 }
 
-/// One block's share of the nodal sums, over nodes `lo..hi`, in the records of the
-/// scatter's layout ([`NodalSums::momentum_only`], [`NodalSums::nonnegative`]); the
-/// other vectors are empty.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct Window<const D: usize> {
+/// A node lattice, numbered axis 0 fastest ([`umls_transfer::Kernel::node_lattice`]),
+/// whose boxes the windows are.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Lattice<const D: usize> {
+    counts: [usize; D],
+    strides: [usize; D],
+    /// 1 / counts, for [`Self::coordinates`].
+    inverse: [f64; D],
+}
+
+impl<const D: usize> Lattice<D> {
+    /// The lattice of `counts` nodes per axis.
+    pub fn new(counts: [usize; D]) -> Self {
+        Self {
+            counts,
+            strides: std::array::from_fn(|k| counts[..k].iter().product()),
+            inverse: counts.map(|n| 1.0 / n as f64),
+        }
+    }
+
+    /// The coordinates of node `node`. Divided through the reciprocal and corrected, as
+    /// integer division by a count known only at run time took 2 % of a B-spline step:
+    /// for quotients below 2⁵⁰ (a lattice of u32 node indices) the product is within 1
+    /// of the quotient, which the correction settles.
+    #[inline]
+    fn coordinates(&self, node: usize) -> [usize; D] {
+        let mut rest = node;
+        std::array::from_fn(|k| {
+            if k + 1 == D {
+                return rest;
+            }
+            let n = self.counts[k];
+            let mut q = (rest as f64 * self.inverse[k]) as usize;
+            if q * n > rest {
+                q -= 1;
+            } else if (q + 1) * n <= rest {
+                q += 1;
+            }
+            let c = rest - q * n;
+            rest = q;
+            c
+        })
+    }
+
+    /// The index of the node at `coordinates`.
+    fn index(&self, coordinates: &[usize; D]) -> usize {
+        (0..D).map(|k| coordinates[k] * self.strides[k]).sum()
+    }
+}
+
+/// A window's box of the lattice: its lowest node's coordinates, its nodes per axis, the
+/// strides of its records (axis 0 fastest) and those of the lattice.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct BoxShape<const D: usize> {
+    corner: [usize; D],
+    extent: [usize; D],
+    strides: [usize; D],
+    lattice_strides: [usize; D],
+}
+
+impl<const D: usize> BoxShape<D> {
+    /// The box from `corner` to `top` (inclusive) of `lattice`.
+    fn new(lattice: &Lattice<D>, corner: [usize; D], top: [usize; D]) -> Self {
+        let extent: [usize; D] = std::array::from_fn(|k| top[k] + 1 - corner[k]);
+        Self {
+            corner,
+            extent,
+            strides: std::array::from_fn(|k| extent[..k].iter().product()),
+            lattice_strides: lattice.strides,
+        }
+    }
+
+    fn nodes(&self) -> usize {
+        self.extent.iter().product()
+    }
+}
+
+/// The nodes one block touches: the index range `lo..hi`, and within it the box `shape`
+/// where the scatter has a lattice.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Extent<const D: usize> {
     lo: usize,
     hi: usize,
+    shape: Option<BoxShape<D>>,
+}
+
+impl<const D: usize> Extent<D> {
+    /// The records a window over it holds.
+    fn nodes(&self) -> usize {
+        self.shape.map_or(self.hi - self.lo, |b| b.nodes())
+    }
+
+    /// Calls `f(node, record, len)` for every run of consecutive nodes of the extent
+    /// within `start..end`, in increasing node order: a box's runs are its rows along
+    /// axis 0, a range is one run.
+    #[inline]
+    // The axis index runs over the digits and two stride arrays at once.
+    #[allow(clippy::needless_range_loop)]
+    fn for_each_run(&self, start: usize, end: usize, mut f: impl FnMut(usize, usize, usize)) {
+        let Some(b) = &self.shape else {
+            let (a, z) = (self.lo.max(start), self.hi.min(end));
+            if a < z {
+                f(a, a - self.lo, z - a);
+            }
+            return;
+        };
+        let rows: usize = b.extent[1..].iter().product();
+        let mut digits = [0usize; D];
+        for _ in 0..rows {
+            let (mut node, mut record) = (self.lo, 0);
+            for k in 1..D {
+                node += digits[k] * b.lattice_strides[k];
+                record += digits[k] * b.strides[k];
+            }
+            if node >= end {
+                return;
+            }
+            let (a, z) = (node.max(start), (node + b.extent[0]).min(end));
+            if a < z {
+                f(a, record + (a - node), z - a);
+            }
+            for k in 1..D {
+                digits[k] += 1;
+                if digits[k] < b.extent[k] {
+                    break;
+                }
+                digits[k] = 0;
+            }
+        }
+    }
+}
+
+/// One block's share of the nodal sums, over the nodes of its [`Extent`], in the records
+/// of the scatter's layout ([`NodalSums::momentum_only`], [`NodalSums::nonnegative`]);
+/// the other vectors are empty.
+#[derive(Debug, Clone)]
+pub(crate) struct Window<const D: usize> {
+    extent: Extent<D>,
     sums: Vec<NodeSums<D, 1>>,
     nonnegative_sums: Vec<NodeSums<D, 0>>,
     momentum_sums: Vec<MomentumSums<D, 1>>,
     nonnegative_momentum_sums: Vec<MomentumSums<D, 0>>,
 }
 
+impl<const D: usize> Default for Window<D> {
+    fn default() -> Self {
+        Self {
+            extent: Extent {
+                lo: 0,
+                hi: 0,
+                shape: None,
+            },
+            sums: Vec::new(),
+            nonnegative_sums: Vec::new(),
+            momentum_sums: Vec::new(),
+            nonnegative_momentum_sums: Vec::new(),
+        }
+    }
+}
+
 impl<const D: usize> Window<D> {
-    fn reset(&mut self, lo: usize, hi: usize, momentum_only: bool, nonnegative: bool) {
-        let len = hi.saturating_sub(lo);
-        self.lo = lo;
-        self.hi = lo + len;
+    fn reset(&mut self, extent: Extent<D>, momentum_only: bool, nonnegative: bool) {
+        let len = extent.nodes();
+        self.extent = extent;
         self.sums.clear();
         self.nonnegative_sums.clear();
         self.momentum_sums.clear();
@@ -218,8 +389,25 @@ impl<const D: usize> Window<D> {
         }
     }
 
-    fn hi(&self) -> usize {
-        self.hi
+    /// Where a tensor-product stencil whose first node is `first`, at `corner` of the
+    /// lattice, with the lattice's `strides`, falls among the records: its first node's
+    /// record and the records' strides per axis.
+    #[inline(always)]
+    pub fn place(
+        &self,
+        first: usize,
+        corner: &[usize; D],
+        strides: &[usize; D],
+    ) -> (usize, [usize; D]) {
+        match &self.extent.shape {
+            Some(b) => (
+                (0..D)
+                    .map(|k| (corner[k] - b.corner[k]) * b.strides[k])
+                    .sum(),
+                b.strides,
+            ),
+            None => (first - self.extent.lo, *strides),
+        }
     }
 
     /// Bytes of the records.
@@ -244,7 +432,28 @@ impl<const D: usize> Window<D> {
         momentum: SVector<f64, D>,
         force: SVector<f64, D>,
     ) {
-        let k = node - self.lo;
+        debug_assert!(self.extent.shape.is_none(), "a box window takes records");
+        self.add_record::<A>(
+            node - self.extent.lo,
+            mass,
+            abs_mass,
+            stiffness,
+            momentum,
+            force,
+        );
+    }
+
+    /// [`Self::add`] to record `k` (see [`Self::place`]).
+    #[inline(always)]
+    pub fn add_record<const A: usize>(
+        &mut self,
+        k: usize,
+        mass: f64,
+        abs_mass: f64,
+        stiffness: f64,
+        momentum: SVector<f64, D>,
+        force: SVector<f64, D>,
+    ) {
         if A == 0 {
             self.nonnegative_sums[k].add(mass, abs_mass, stiffness, momentum, force);
         } else {
@@ -263,7 +472,19 @@ impl<const D: usize> Window<D> {
         abs_mass: f64,
         momentum: SVector<f64, D>,
     ) {
-        let k = node - self.lo;
+        debug_assert!(self.extent.shape.is_none(), "a box window takes records");
+        self.add_momentum_record::<A>(node - self.extent.lo, mass, abs_mass, momentum);
+    }
+
+    /// [`Self::add_momentum`] to record `k` (see [`Self::place`]).
+    #[inline(always)]
+    pub fn add_momentum_record<const A: usize>(
+        &mut self,
+        k: usize,
+        mass: f64,
+        abs_mass: f64,
+        momentum: SVector<f64, D>,
+    ) {
         if A == 0 {
             self.nonnegative_momentum_sums[k].add(mass, abs_mass, momentum);
         } else {
@@ -279,9 +500,9 @@ pub(crate) struct NodalSums<'a, const D: usize> {
     pub stiffness: &'a mut [f64],
     pub momentum: &'a mut [SVector<f64, D>],
     pub force: &'a mut [SVector<f64, D>],
-    /// Per chunk of [`NODE_CHUNK`] nodes: whether it may hold non-zero values this step
-    /// (a block's window reaches it now, or reached it in the last step, whose values
-    /// must be cleared). Written by [`Scatter::scatter`].
+    /// Per segment of [`LIVE_SEGMENT`] nodes: whether it may hold non-zero values this
+    /// step (a block's window reaches it now, or reached it in the last step, whose
+    /// values must be cleared). Written by [`Scatter::scatter`].
     pub live: &'a mut [bool],
     /// Only mass, |N|-mass and momentum are scattered (MLS-MPM, whose momentum carries
     /// the force): the stiffness and force arrays are neither cleared nor summed, and
@@ -297,6 +518,19 @@ pub(crate) struct NodalSums<'a, const D: usize> {
 /// chunk do not depend on the thread count).
 pub(crate) const NODE_CHUNK: usize = 4096;
 
+/// Nodes per segment of the grid's live flags: fine enough that a row of a box window
+/// (the body's width along axis 0) marks little more than itself live, so that the
+/// merge and the grid update skip the empty rest of the grid's rows.
+pub(crate) const LIVE_SEGMENT: usize = 16;
+
+/// Live flags per chunk of [`NODE_CHUNK`] nodes.
+pub(crate) const SEGMENTS_PER_CHUNK: usize = NODE_CHUNK / LIVE_SEGMENT;
+
+/// The live flags `nodes` nodes need.
+pub(crate) fn live_segments(nodes: usize) -> usize {
+    nodes.div_ceil(LIVE_SEGMENT)
+}
+
 /// The particle order, the blocks and their windows, reused from step to step.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Scatter<const D: usize> {
@@ -304,10 +538,10 @@ pub(crate) struct Scatter<const D: usize> {
     order: Vec<u32>,
     /// Start of each block in `order` (and its end, last).
     bounds: Vec<usize>,
-    /// The node range `lo..hi` each block touches.
-    ranges: Vec<(usize, usize)>,
+    /// The nodes each block touches.
+    ranges: Vec<Extent<D>>,
     windows: Vec<Window<D>>,
-    /// Chunks of [`NODE_CHUNK`] nodes the last scatter's windows reached.
+    /// Segments of [`LIVE_SEGMENT`] nodes the last scatter's windows reached.
     reached: Vec<bool>,
 }
 
@@ -328,8 +562,9 @@ impl<const D: usize> Scatter<D> {
     }
 
     /// Orders the particles by the lowest node of their stencil and cuts them into
-    /// blocks; `ranges` holds each particle's lowest and highest node.
-    fn plan(&mut self, ranges: &[(u32, u32)], nodes: usize) {
+    /// blocks; `ranges` holds each particle's lowest and highest node, which on a
+    /// `lattice` are the corners of the box its stencil covers.
+    fn plan(&mut self, ranges: &[(u32, u32)], nodes: usize, lattice: Option<&Lattice<D>>) {
         let particles = ranges.len();
         self.keys.clear();
         if self.order.len() == particles {
@@ -353,13 +588,43 @@ impl<const D: usize> Scatter<D> {
         self.order.extend(self.keys.iter().map(|&(_, p)| p));
         let order = &self.order;
         let range = |b: &[usize]| {
-            let (lo, hi) = order[b[0]..b[1]]
-                .iter()
-                .map(|&p| ranges[p as usize])
-                .fold((u32::MAX, 0u32), |(lo, hi), (a, z)| {
-                    (lo.min(a), hi.max(z + 1))
-                });
-            (lo as usize, (hi as usize).max(lo as usize))
+            let block = order[b[0]..b[1]].iter().map(|&p| ranges[p as usize]);
+            if let Some(lattice) = lattice {
+                let (corner, top) = block.fold(
+                    ([usize::MAX; D], [0; D]),
+                    |(mut corner, mut top), (a, z)| {
+                        let (a, z) = (
+                            lattice.coordinates(a as usize),
+                            lattice.coordinates(z as usize),
+                        );
+                        for k in 0..D {
+                            corner[k] = corner[k].min(a[k]);
+                            top[k] = top[k].max(z[k]);
+                        }
+                        (corner, top)
+                    },
+                );
+                if b[0] == b[1] {
+                    return Extent {
+                        lo: 0,
+                        hi: 0,
+                        shape: None,
+                    };
+                }
+                return Extent {
+                    lo: lattice.index(&corner),
+                    hi: lattice.index(&top) + 1,
+                    shape: Some(BoxShape::new(lattice, corner, top)),
+                };
+            }
+            let (lo, hi) = block.fold((u32::MAX, 0u32), |(lo, hi), (a, z)| {
+                (lo.min(a), hi.max(z + 1))
+            });
+            Extent {
+                lo: lo as usize,
+                hi: (hi as usize).max(lo as usize),
+                shape: None,
+            }
         };
         let mut size = BLOCK;
         loop {
@@ -369,7 +634,7 @@ impl<const D: usize> Scatter<D> {
             self.ranges.clear();
             self.ranges
                 .par_extend(self.bounds.par_windows(2).map(range));
-            let span: usize = self.ranges.iter().map(|(lo, hi)| hi - lo).sum();
+            let span: usize = self.ranges.iter().map(Extent::nodes).sum();
             if span <= MAX_SPAN * nodes || size >= particles {
                 break;
             }
@@ -380,13 +645,17 @@ impl<const D: usize> Scatter<D> {
     /// Scatters the particles through `contribute(block, window)`, where `block` lists
     /// one block's particles in order, and sums the windows into `sums` (every node of a
     /// live chunk written, nodes no particle touches with zero; chunks neither reached
-    /// now nor in the last step are zero already and are skipped). `ranges` holds each particle's
-    /// lowest and highest stencil node. Among failing blocks the lowest particle index
-    /// wins, whatever the thread count; on failure `sums` is left as it was.
+    /// now nor in the last step are zero already and are skipped; the same per segment
+    /// of a chunk). `ranges` holds each particle's lowest and highest stencil node. Given the kernel's `lattice`, the
+    /// windows are boxes of it, and `contribute` must add through
+    /// [`Window::place`]'s records (tensor-product stencils). Among failing blocks the
+    /// lowest particle index wins, whatever the thread count; on failure `sums` is left
+    /// as it was.
     pub fn scatter<F, E>(
         &mut self,
         ranges: &[(u32, u32)],
         sums: NodalSums<'_, D>,
+        lattice: Option<&Lattice<D>>,
         contribute: F,
     ) -> Result<(), (usize, E)>
     where
@@ -395,7 +664,7 @@ impl<const D: usize> Scatter<D> {
     {
         let nodes = sums.mass.len();
         let (momentum_only, nonnegative) = (sums.momentum_only, sums.nonnegative);
-        self.plan(ranges, nodes);
+        self.plan(ranges, nodes, lattice);
         let blocks = self.bounds.len() - 1;
         self.windows.resize_with(blocks, Window::default);
         let (order, bounds, block_ranges) = (&self.order, &self.bounds, &self.ranges);
@@ -403,8 +672,7 @@ impl<const D: usize> Scatter<D> {
             .par_iter_mut()
             .enumerate()
             .map(|(b, window)| {
-                let (lo, hi) = block_ranges[b];
-                window.reset(lo, hi, momentum_only, nonnegative);
+                window.reset(block_ranges[b], momentum_only, nonnegative);
                 contribute(&order[bounds[b]..bounds[b + 1]], window)
             })
             .reduce(|| Ok(()), |a, b| lowest_failure(a, b, |(), ()| ()))?;
@@ -413,11 +681,13 @@ impl<const D: usize> Scatter<D> {
         self.reached.resize(sums.live.len(), false);
         sums.live.copy_from_slice(&self.reached);
         self.reached.fill(false);
-        for &(lo, hi) in block_ranges.iter().filter(|(lo, hi)| hi > lo) {
-            for c in lo / NODE_CHUNK..=(hi - 1) / NODE_CHUNK {
-                self.reached[c] = true;
-                sums.live[c] = true;
-            }
+        for extent in block_ranges.iter() {
+            extent.for_each_run(0, nodes, |node, _, len| {
+                for c in node / LIVE_SEGMENT..=(node + len - 1) / LIVE_SEGMENT {
+                    self.reached[c] = true;
+                    sums.live[c] = true;
+                }
+            });
         }
         let windows = &self.windows[..blocks];
         match (momentum_only, nonnegative) {
@@ -472,7 +742,8 @@ fn merge<const D: usize, R: Record<D>>(sums: NodalSums<'_, D>, windows: &[Window
         });
 }
 
-/// Chunk `c` of the merge: cleared and summed if live, skipped otherwise.
+/// Chunk `c` of the merge: its live segments cleared, then summed (windows reach live
+/// segments only); skipped if none is live.
 #[inline(always)]
 fn merge_chunk<const D: usize, R: Record<D>>(
     c: usize,
@@ -480,10 +751,14 @@ fn merge_chunk<const D: usize, R: Record<D>>(
     live: &[bool],
     windows: &[Window<D>],
 ) {
-    if !live[c] {
+    let live = &live[c * SEGMENTS_PER_CHUNK..live.len().min((c + 1) * SEGMENTS_PER_CHUNK)];
+    if !live.iter().any(|&l| l) {
         return;
     }
-    R::clear(&mut chunk);
+    for (s, _) in live.iter().enumerate().filter(|(_, l)| **l) {
+        let range = s * LIVE_SEGMENT..chunk.mass.len().min((s + 1) * LIVE_SEGMENT);
+        R::clear(&mut chunk.part(range));
+    }
     let start = c * NODE_CHUNK;
     let end = start + chunk.mass.len();
     for_each_covered(windows, start, end, |j, k, w| {
@@ -502,8 +777,170 @@ fn for_each_covered<const D: usize>(
     mut add: impl FnMut(usize, usize, &Window<D>),
 ) {
     for w in windows {
-        for node in w.lo.max(start)..w.hi().min(end) {
-            add(node - start, node - w.lo, w);
+        if w.extent.hi <= start || w.extent.lo >= end {
+            continue;
+        }
+        w.extent.for_each_run(start, end, |node, record, len| {
+            for i in 0..len {
+                add(node - start + i, record + i, w);
+            }
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A xorshift stream, for reproducible pseudo-random cases.
+    fn stream(mut seed: u64) -> impl FnMut() -> u64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        }
+    }
+
+    /// The reciprocal division gives every node's coordinates exactly: the first and
+    /// last nodes, random ones, and the quotients' edges, on awkward counts and on a 2D
+    /// lattice of nearly 2³² nodes.
+    #[test]
+    fn lattice_coordinates_invert_the_numbering() {
+        let mut next = stream(11);
+        let cases: [[usize; 3]; 4] = [[65, 65, 65], [1, 7, 3], [4097, 3, 1], [69, 1, 2]];
+        for counts in cases {
+            let lattice = Lattice::new(counts);
+            let nodes: usize = counts.iter().product();
+            let edges = (1..nodes).step_by(counts[0]).flat_map(|n| [n - 1, n]);
+            let random = (0..2000).map(|_| next() as usize % nodes);
+            for node in [0, nodes - 1].into_iter().chain(edges).chain(random) {
+                let c = lattice.coordinates(node);
+                assert!((0..3).all(|k| c[k] < counts[k]), "{counts:?} {node}: {c:?}");
+                assert_eq!(lattice.index(&c), node, "{counts:?}: {c:?}");
+            }
+        }
+        let lattice = Lattice::new([65_521, 65_537]);
+        let nodes = 65_521 * 65_537;
+        for node in (0..4000)
+            .map(|_| next() as usize % nodes)
+            .chain([nodes - 1, 65_520, 65_521])
+        {
+            let c = lattice.coordinates(node);
+            assert!(c[0] < 65_521 && c[1] < 65_537, "{node}: {c:?}");
+            assert_eq!(lattice.index(&c), node);
+        }
+    }
+
+    /// Random 3×3×3 stencils on a 3D lattice, scattered through box windows and through
+    /// range windows over two steps (the second elsewhere, so that the first's nodes must
+    /// be cleared): the same sums bit for bit, with both record layouts, equal to a serial
+    /// sum to round-off; nodes no stencil reaches hold zero, and only live segments
+    /// hold anything.
+    #[test]
+    fn box_windows_sum_what_range_windows_sum() {
+        let counts = [23, 17, 19];
+        let lattice = Lattice::new(counts);
+        let nodes: usize = counts.iter().product();
+        let mut next = stream(5);
+        for momentum_only in [false, true] {
+            let mut scatters = [Scatter::<3>::default(), Scatter::<3>::default()];
+            let mut grids: Vec<[Vec<f64>; 2]> = vec![Default::default(), Default::default()];
+            let mut moms: Vec<Vec<SVector<f64, 3>>> = vec![Vec::new(), Vec::new()];
+            let mut lives = vec![vec![false; live_segments(nodes)]; 2];
+            let mut forces = vec![vec![SVector::zeros(); nodes]; 2];
+            let mut stiffs = vec![vec![0.0; nodes]; 2];
+            for g in 0..2 {
+                grids[g] = [vec![0.0; nodes], vec![0.0; nodes]];
+                moms[g] = vec![SVector::zeros(); nodes];
+            }
+            for step in 0..2 {
+                // Particles in one half of the lattice per step, 9000 of them (three
+                // blocks).
+                let half = if step == 0 { 0 } else { counts[2] / 2 };
+                let corners: Vec<[usize; 3]> = (0..9000)
+                    .map(|_| {
+                        [
+                            next() as usize % (counts[0] - 2),
+                            next() as usize % (counts[1] - 2),
+                            half + next() as usize % (counts[2] / 2 - 2),
+                        ]
+                    })
+                    .collect();
+                let values: Vec<f64> = (0..corners.len() * 27)
+                    .map(|_| (next() % 1000) as f64 / 999.0)
+                    .collect();
+                let ranges: Vec<(u32, u32)> = corners
+                    .iter()
+                    .map(|c| {
+                        let top = [c[0] + 2, c[1] + 2, c[2] + 2];
+                        (lattice.index(c) as u32, lattice.index(&top) as u32)
+                    })
+                    .collect();
+                for (g, boxed) in [(0, false), (1, true)] {
+                    let [mass, abs_mass] = &mut grids[g];
+                    let sums = NodalSums {
+                        mass,
+                        abs_mass,
+                        stiffness: &mut stiffs[g],
+                        momentum: &mut moms[g],
+                        force: &mut forces[g],
+                        live: &mut lives[g],
+                        momentum_only,
+                        nonnegative: true,
+                    };
+                    let on = boxed.then_some(&lattice);
+                    scatters[g]
+                        .scatter(&ranges, sums, on, |block, window| {
+                            for &p in block {
+                                let c = corners[p as usize];
+                                let first = lattice.index(&c);
+                                let (record, strides) = window.place(first, &c, &lattice.strides);
+                                for e in 0..27 {
+                                    let a = [e % 3, (e / 3) % 3, e / 9];
+                                    let n = values[p as usize * 27 + e];
+                                    let node = first
+                                        + (0..3).map(|k| a[k] * lattice.strides[k]).sum::<usize>();
+                                    let k =
+                                        record + (0..3).map(|k| a[k] * strides[k]).sum::<usize>();
+                                    let v = SVector::from([n, 2.0 * n, -n]);
+                                    match (momentum_only, boxed) {
+                                        (true, true) => window.add_momentum_record::<0>(k, n, n, v),
+                                        (true, false) => window.add_momentum::<0>(node, n, n, v),
+                                        (false, true) => {
+                                            window.add_record::<0>(k, n, n, n * n, v, -v)
+                                        }
+                                        (false, false) => window.add::<0>(node, n, n, n * n, v, -v),
+                                    }
+                                }
+                            }
+                            Ok::<(), (usize, ())>(())
+                        })
+                        .unwrap();
+                }
+                let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&grids[0][0]), bits(&grids[1][0]), "mass, step {step}");
+                assert_eq!(moms[0], moms[1], "momentum, step {step}");
+                assert_eq!(bits(&stiffs[0]), bits(&stiffs[1]), "stiffness, step {step}");
+                assert_eq!(forces[0], forces[1], "force, step {step}");
+                // A serial sum: the same to round-off; zero where nothing reaches.
+                let mut serial = vec![0.0; nodes];
+                for (p, c) in corners.iter().enumerate() {
+                    for e in 0..27 {
+                        let a = [c[0] + e % 3, c[1] + (e / 3) % 3, c[2] + e / 9];
+                        serial[lattice.index(&a)] += values[p * 27 + e];
+                    }
+                }
+                for (node, (s, m)) in serial.iter().zip(&grids[1][0]).enumerate() {
+                    assert!(
+                        (s - m).abs() <= 1e-12 * s.abs(),
+                        "node {node}: {m} against {s}"
+                    );
+                    if *m != 0.0 {
+                        assert!(lives[1][node / LIVE_SEGMENT], "node {node} not live");
+                    }
+                }
+            }
         }
     }
 }

@@ -1,5 +1,6 @@
-//! P2G and the grid update skip chunks of nodes that no particle reached in this step or
-//! the last; a body crossing a large grid must leave no stale values behind it.
+//! P2G and the grid update skip segments of nodes that no particle reached in this step
+//! or the last (P2G's windows being boxes of the B-spline lattice); a body crossing a
+//! large grid must leave no stale values behind it.
 
 use nalgebra::{SVector, Vector2};
 use umls_constitutive::{ElasticParameters, LinearElastic};
@@ -60,7 +61,8 @@ fn a_body_crossing_the_grid_leaves_no_stale_nodes() {
         (momentum - start).norm() < 1e-12 * start.norm(),
         "{momentum:?} against {start:?}"
     );
-    // The block has crossed several chunks of 4096 nodes (20 rows of 201 nodes each).
+    // The block has crossed several chunks of 4096 nodes (20 rows of 201 nodes each),
+    // and many more live segments of 16.
     let centre = sim.particles().position.iter().sum::<Vector2<f64>>() / n as f64;
     assert!(centre.y > 0.7, "{centre:?}");
 }

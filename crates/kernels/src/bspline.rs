@@ -239,6 +239,10 @@ impl<const D: usize> Kernel<D> for BSplineKernel<D> {
         Some(self.order.width())
     }
 
+    fn node_lattice(&self) -> Option<[usize; D]> {
+        Some(std::array::from_fn(|k| self.cells[k] + 1))
+    }
+
     #[inline(always)]
     fn tensor_stencil<const W: usize>(
         &self,
@@ -314,6 +318,7 @@ impl<const D: usize> BSplineKernel<D> {
         let base = self.base_nodes_of(order, x)?;
         let mut tensor = TensorStencil {
             first: self.node_index(base),
+            corner: base,
             strides: self.strides(),
             values: [[0.0; W]; D],
             derivatives: [[0.0; W]; D],
@@ -369,6 +374,7 @@ impl<const D: usize> BSplineKernel<D> {
             values: w,
             derivatives: dw,
             offsets: r,
+            ..
         } = self.tensor_of_width::<W>(order, x)?;
         // The factors are multiplied in axis order, as N = Π_k w_k reads (regrouping
         // them would change the last bit of the results).

@@ -312,6 +312,46 @@ fn check_tensor<const D: usize, K: Kernel<D>>(
     outcomes.try_for_each(|outcome| outcome)
 }
 
+/// A tensor stencil's `corner` names its `first` node; where the kernel declares its
+/// node lattice, the strides are the lattice's, the stencil lies inside it and the
+/// lattice holds every node.
+fn check_lattice<const D: usize, K: Kernel<D>, const W: usize>(
+    kernel: &K,
+    t: &TensorStencil<D, W>,
+) -> Result<(), String> {
+    let first: usize = (0..D).map(|k| t.corner[k] * t.strides[k]).sum();
+    if first != t.first {
+        return Err(format!(
+            "tensor_stencil's corner {:?} with strides {:?} names node {first}, not its \
+             first node {}",
+            t.corner, t.strides, t.first
+        ));
+    }
+    let Some(counts) = kernel.node_lattice() else {
+        return Ok(());
+    };
+    let strides: [usize; D] = std::array::from_fn(|k| counts[..k].iter().product());
+    if strides != t.strides {
+        return Err(format!(
+            "node_lattice {counts:?} has strides {strides:?}, tensor_stencil {:?}",
+            t.strides
+        ));
+    }
+    if (0..D).any(|k| t.corner[k] + W > counts[k]) {
+        return Err(format!(
+            "tensor_stencil's corner {:?} of width {W} leaves node_lattice {counts:?}",
+            t.corner
+        ));
+    }
+    if counts.iter().product::<usize>() != kernel.node_count() {
+        return Err(format!(
+            "node_lattice {counts:?} does not hold node_count {} nodes",
+            kernel.node_count()
+        ));
+    }
+    Ok(())
+}
+
 /// [`check_tensor`] for the width `W`.
 // The axis index runs over several per-axis arrays at once.
 #[allow(clippy::needless_range_loop)]
@@ -333,6 +373,7 @@ fn tensor_of_width<const D: usize, K: Kernel<D>, const W: usize>(
     }
     let t: TensorStencil<D, W> =
         result.map_err(|e| format!("tensor_stencil fails inside the domain: {e}"))?;
+    check_lattice(kernel, &t)?;
     let mut rebuilt = Stencil::new();
     let mut digits = [0usize; D];
     'entries: loop {

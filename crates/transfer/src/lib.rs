@@ -238,6 +238,15 @@ pub trait Kernel<const D: usize>: Send + Sync {
         None
     }
 
+    /// The nodes per axis where the kernel numbers its nodes on a lattice, axis 0 fastest
+    /// (node (i₀, i₁, …) is i₀ + n₀ (i₁ + n₁ (…)), and its [`Self::tensor_stencil`]s give
+    /// the same numbering through `corner` and `strides`; `None` (the default) otherwise.
+    /// With it, the engine's P2G sums each block of particles into a box of the lattice
+    /// instead of a range of node indices, which in 3D spans whole planes of the grid.
+    fn node_lattice(&self) -> Option<[usize; D]> {
+        None
+    }
+
     /// The stencil at `x` as per-axis factors, for a kernel whose [`Self::tensor_width`]
     /// is `Some(W)`: the entries of [`Self::stencil`] (N and ∇N as the factors' products
     /// in axis order give them), failing where it fails. The default, like a kernel asked

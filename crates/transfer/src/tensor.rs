@@ -14,6 +14,10 @@
 pub struct TensorStencil<const D: usize, const W: usize> {
     /// The node at the stencil's lowest corner (a = 0 on every axis).
     pub first: usize,
+    /// That node's place on the node lattice, per axis: `first` is
+    /// `Σ_k corner[k] strides[k]`. Lets a transfer sum into a box of the lattice rather
+    /// than into a range of node indices.
+    pub corner: [usize; D],
     /// How far the node index moves per node along each axis.
     pub strides: [usize; D],
     /// N's factor per axis and node.

@@ -111,7 +111,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         solve.product.resize(nodes, SVector::zeros());
         solve.mass.resize(nodes, 0.0);
         solve.abs_mass.resize(nodes, 0.0);
-        solve.live.resize(nodes.div_ceil(NODE_CHUNK), false);
+        solve
+            .live
+            .resize(crate::scatter::live_segments(nodes), false);
         let grid = &self.grid;
         let active = |i: usize| grid.is_active(i, fraction);
         let rhs_in: &[SVector<f64, D>] = rhs;
@@ -150,7 +152,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             };
             solve
                 .scatter
-                .scatter(stencils.ranges(), sums, |block, window| {
+                .scatter(stencils.ranges(), sums, None, |block, window| {
                     let mut scratch = Stencil::new();
                     for &i in block {
                         let i = i as usize;

@@ -139,8 +139,12 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let tensor_width = row_width(kernel).filter(|_| {
             A == 0 && !CORRECTED && !(T::AFFINE && varying_moment) && stencils.recomputed()
         });
+        // Summed row by row, the blocks' windows can be boxes of the kernel's lattice.
+        let lattice = tensor_width
+            .and(kernel.node_lattice())
+            .map(crate::scatter::Lattice::new);
         self.scatter
-            .scatter(ranges, sums, |block, window| {
+            .scatter(ranges, sums, lattice.as_ref(), |block, window| {
                 let mut scratch = Stencil::new();
                 for &i in block {
                     let i = i as usize;

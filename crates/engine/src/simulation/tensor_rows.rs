@@ -37,7 +37,8 @@ fn next_row<const D: usize, const W: usize>(digits: &mut [usize; D]) -> bool {
     false
 }
 
-/// A row's first node, the product of its weights along axes 1..D, and for each axis
+/// A row's first node (counted from `first` with `strides`: the grid's, or a P2G
+/// window's records'), the product of its weights along axes 1..D, and for each axis
 /// j ≥ 1 the product with axis j's derivative in place of its weight (∂N/∂x_j = w₀ times
 /// it; entry 0 unused).
 #[inline(always)]
@@ -45,12 +46,13 @@ fn next_row<const D: usize, const W: usize>(digits: &mut [usize; D]) -> bool {
 #[allow(clippy::needless_range_loop)]
 fn row_factors<const D: usize, const W: usize>(
     t: &TensorStencil<D, W>,
+    (first, strides): (usize, &[usize; D]),
     digits: &[usize; D],
 ) -> (usize, f64, [f64; D]) {
-    let mut node = t.first;
+    let mut node = first;
     let mut weight = 1.0;
     for k in 1..D {
-        node += digits[k] * t.strides[k];
+        node += digits[k] * strides[k];
         weight *= t.values[k][digits[k]];
     }
     let gradient = std::array::from_fn(|j| {
@@ -104,9 +106,10 @@ pub(super) fn scatter_rows<const D: usize, const W: usize, T: TransferScheme>(
     let c = columns(&load.affine);
     let s = columns(&load.stress_volume);
     let m = load.mass;
+    let (first, strides) = window.place(t.first, &t.corner, &t.strides);
     let mut digits = [0usize; D];
     loop {
-        let (node, weight, gradient) = row_factors(t, &digits);
+        let (node, weight, gradient) = row_factors(t, (first, &strides), &digits);
         // The momentum (per unit N m, or per unit N under MLS-MPM) without axis 0's
         // share of C r.
         let mut base: [f64; D] = std::array::from_fn(|j| load.velocity[j]);
@@ -124,7 +127,7 @@ pub(super) fn scatter_rows<const D: usize, const W: usize, T: TransferScheme>(
                 let nm = n * m;
                 let r = t.offsets[0][a];
                 let p = SVector::<f64, D>::from_fn(|j, _| (base[j] + c[0][j] * r) * n);
-                window.add_momentum::<0>(node + a, nm, nm, p);
+                window.add_momentum_record::<0>(node + a, nm, nm, p);
             }
         } else {
             // Axes 1..D's share of V τ ∇N (per unit w₀) and of |∇N|² (per unit w₀²).
@@ -153,7 +156,7 @@ pub(super) fn scatter_rows<const D: usize, const W: usize, T: TransferScheme>(
                     load.acceleration[j] * nm - (s[0][j] * g0 + stress_row[j] * w)
                 });
                 let stiffness = load.volume * (g0 * g0 + w * w * squares);
-                window.add::<0>(node + a, nm, nm, stiffness, momentum, force);
+                window.add_record::<0>(node + a, nm, nm, stiffness, momentum, force);
             }
         }
         if !next_row::<D, W>(&mut digits) {
@@ -184,7 +187,7 @@ pub(super) fn gather_rows<const D: usize, const W: usize, T: TransferScheme>(
     let mut b = [[0.0; D]; D];
     let mut digits = [0usize; D];
     loop {
-        let (node, weight, gradient) = row_factors(t, &digits);
+        let (node, weight, gradient) = row_factors(t, (t.first, &t.strides), &digits);
         let velocities = &new[node..node + W];
         // The row's Σ w₀ ṽ, Σ w₀ r₀ ṽ, Σ w₀' ṽ and Σ w₀ (ṽ − v).
         let mut row = [0.0; D];
