@@ -79,6 +79,9 @@ pub struct BSplineKernel<const D: usize> {
     h: f64,
     cells: [usize; D],
     order: BSplineOrder,
+    /// 1 / h: the stencils multiply by it, as a division per node and axis took a tenth
+    /// of G2P.
+    inverse_h: f64,
 }
 
 impl<const D: usize> BSplineKernel<D> {
@@ -104,6 +107,7 @@ impl<const D: usize> BSplineKernel<D> {
             h,
             cells,
             order,
+            inverse_h: 1.0 / h,
         })
     }
 
@@ -159,7 +163,7 @@ impl<const D: usize> BSplineKernel<D> {
         let width = order.width();
         let mut base = [0usize; D];
         for k in 0..D {
-            match order.base((x[k] - self.origin[k]) / self.h) {
+            match order.base((x[k] - self.origin[k]) * self.inverse_h) {
                 // Checked: a huge ξ saturates to usize::MAX.
                 Some(b)
                     if b.checked_add(width - 1)
@@ -325,12 +329,12 @@ impl<const D: usize> BSplineKernel<D> {
             offsets: [[0.0; W]; D],
         };
         for k in 0..D {
-            let xi = (x[k] - self.origin[k]) / self.h;
+            let xi = (x[k] - self.origin[k]) * self.inverse_h;
             for a in 0..W {
                 let node = (base[k] + a) as f64;
                 let (value, derivative) = order.weight(xi - node);
                 tensor.values[k][a] = value;
-                tensor.derivatives[k][a] = derivative / self.h;
+                tensor.derivatives[k][a] = derivative * self.inverse_h;
                 tensor.offsets[k][a] = self.origin[k] + self.h * node - x[k];
             }
         }
