@@ -419,33 +419,20 @@ impl<const D: usize> Window<D> {
             + bytes(&self.nonnegative_momentum_sums)
     }
 
-    /// Adds one stencil entry's contributions to `node`, in a window of a full scatter
-    /// ([`NodalSums::momentum_only`] false); `A` is 0 where [`NodalSums::nonnegative`]
-    /// holds (`abs_mass` is then not summed), else 1.
+    /// The record of `node` in a range window (a box window's records come from
+    /// [`Self::place`]).
     #[inline(always)]
-    pub fn add<const A: usize>(
-        &mut self,
-        node: usize,
-        mass: f64,
-        abs_mass: f64,
-        stiffness: f64,
-        momentum: SVector<f64, D>,
-        force: SVector<f64, D>,
-    ) {
+    pub fn record(&self, node: usize) -> usize {
         debug_assert!(self.extent.shape.is_none(), "a box window takes records");
-        self.add_record::<A>(
-            node - self.extent.lo,
-            mass,
-            abs_mass,
-            stiffness,
-            momentum,
-            force,
-        );
+        node - self.extent.lo
     }
 
-    /// [`Self::add`] to record `k` (see [`Self::place`]).
+    /// Adds one stencil entry's contributions to record `k` ([`Self::record`],
+    /// [`Self::place`]), in a window of a full scatter ([`NodalSums::momentum_only`]
+    /// false); `A` is 0 where [`NodalSums::nonnegative`] holds (`abs_mass` is then not
+    /// summed), else 1.
     #[inline(always)]
-    pub fn add_record<const A: usize>(
+    pub fn add<const A: usize>(
         &mut self,
         k: usize,
         mass: f64,
@@ -461,24 +448,11 @@ impl<const D: usize> Window<D> {
         }
     }
 
-    /// Adds one stencil entry's mass and momentum to `node`, in a window of a
+    /// Adds one stencil entry's mass and momentum to record `k`, in a window of a
     /// momentum-only scatter (MLS-MPM, whose momentum carries the force impulse: no
     /// separate force or stiffness); `A` as for [`Self::add`].
     #[inline(always)]
     pub fn add_momentum<const A: usize>(
-        &mut self,
-        node: usize,
-        mass: f64,
-        abs_mass: f64,
-        momentum: SVector<f64, D>,
-    ) {
-        debug_assert!(self.extent.shape.is_none(), "a box window takes records");
-        self.add_momentum_record::<A>(node - self.extent.lo, mass, abs_mass, momentum);
-    }
-
-    /// [`Self::add_momentum`] to record `k` (see [`Self::place`]).
-    #[inline(always)]
-    pub fn add_momentum_record<const A: usize>(
         &mut self,
         k: usize,
         mass: f64,
@@ -905,12 +879,14 @@ mod tests {
                                         record + (0..3).map(|k| a[k] * strides[k]).sum::<usize>();
                                     let v = SVector::from([n, 2.0 * n, -n]);
                                     match (momentum_only, boxed) {
-                                        (true, true) => window.add_momentum_record::<0>(k, n, n, v),
-                                        (true, false) => window.add_momentum::<0>(node, n, n, v),
-                                        (false, true) => {
-                                            window.add_record::<0>(k, n, n, n * n, v, -v)
+                                        (true, true) => window.add_momentum::<0>(k, n, n, v),
+                                        (true, false) => {
+                                            window.add_momentum::<0>(window.record(node), n, n, v)
                                         }
-                                        (false, false) => window.add::<0>(node, n, n, n * n, v, -v),
+                                        (false, true) => window.add::<0>(k, n, n, n * n, v, -v),
+                                        (false, false) => {
+                                            window.add::<0>(window.record(node), n, n, n * n, v, -v)
+                                        }
                                     }
                                 }
                             }

@@ -186,7 +186,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                     u += c * st.offset(e, kernel, &x);
                                 }
                                 window.add_momentum::<1>(
-                                    st.nodes[e] as usize,
+                                    window.record(st.nodes[e] as usize),
                                     n * m,
                                     n.abs() * m,
                                     u * (n * m),

@@ -63,8 +63,9 @@ impl<const D: usize, T: TransferScheme, const CORRECTED: bool, const A: usize> E
         if T::FUSED_FORCE {
             // `velocity` is m (v + Δt a) and `affine` m C − Δt V τ D⁻¹ here.
             let momentum = self.load.velocity + self.load.affine * r;
+            let k = self.window.record(node as usize);
             self.window
-                .add_momentum::<A>(node as usize, n * m, n.abs() * m, momentum * n);
+                .add_momentum::<A>(k, n * m, n.abs() * m, momentum * n);
             return;
         }
         let mut mv = self.load.velocity;
@@ -78,8 +79,9 @@ impl<const D: usize, T: TransferScheme, const CORRECTED: bool, const A: usize> E
         } else {
             gradient
         };
+        let k = self.window.record(node as usize);
         self.window.add::<A>(
-            node as usize,
+            k,
             n * m,
             n.abs() * m,
             self.load.volume * gradient.norm_squared(),

@@ -127,7 +127,7 @@ pub(super) fn scatter_rows<const D: usize, const W: usize, T: TransferScheme>(
                 let nm = n * m;
                 let r = t.offsets[0][a];
                 let p = SVector::<f64, D>::from_fn(|j, _| (base[j] + c[0][j] * r) * n);
-                window.add_momentum_record::<0>(node + a, nm, nm, p);
+                window.add_momentum::<0>(node + a, nm, nm, p);
             }
         } else {
             // Axes 1..D's share of V τ ∇N (per unit w₀) and of |∇N|² (per unit w₀²).
@@ -156,7 +156,7 @@ pub(super) fn scatter_rows<const D: usize, const W: usize, T: TransferScheme>(
                     load.acceleration[j] * nm - (s[0][j] * g0 + stress_row[j] * w)
                 });
                 let stiffness = load.volume * (g0 * g0 + w * w * squares);
-                window.add_record::<0>(node + a, nm, nm, stiffness, momentum, force);
+                window.add::<0>(node + a, nm, nm, stiffness, momentum, force);
             }
         }
         if !next_row::<D, W>(&mut digits) {
