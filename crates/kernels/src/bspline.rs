@@ -79,8 +79,8 @@ pub struct BSplineKernel<const D: usize> {
     h: f64,
     cells: [usize; D],
     order: BSplineOrder,
-    /// 1 / h: the stencils multiply by it, as a division per node and axis took a tenth
-    /// of G2P.
+    /// 1 / h: the stencils multiply by it, as a division per node and axis cost G2P up
+    /// to a tenth of its time.
     inverse_h: f64,
 }
 
