@@ -11,8 +11,9 @@ const H: f64 = 0.1;
 const DT: f64 = 1e-3;
 
 /// One particle at x = 0.5 moving right at `courant` cells per step, on a quadratic
-/// B-spline grid of spacing `H`, with a fixed wall just ahead of it (on no grid node,
-/// so the grid velocity stays the particle's).
+/// B-spline grid of spacing `H`, with a fixed wall just ahead of it. The wall holds the
+/// particle only: it is given without its nodes, so the grid velocity stays the
+/// particle's.
 fn run_into_wall(courant: f64) -> Result<(), EngineError> {
     let grid =
         BSplineKernel::new(SVector::from([0.0]), H, [11], BSplineOrder::Quadratic).expect("grid");
