@@ -36,7 +36,7 @@ use nalgebra::SVector;
 use rayon::prelude::*;
 
 use crate::boundary::Boundary;
-use crate::scatter::{LIVE_SEGMENT, NODE_CHUNK, SEGMENTS_PER_CHUNK, live_segments};
+use crate::scatter::{NODE_CHUNK, SEGMENTS_PER_CHUNK, live_ranges, live_segments};
 use crate::settings::Damping;
 
 /// Nodal fields of one step.
@@ -65,10 +65,10 @@ pub(crate) struct Grid<const D: usize> {
     /// ṽ_i = v_i + Δt f_i / m_i (Δt f_i / Δt² k_i on mass-scaled nodes), plus the
     /// redistributed impulse, with boundary conditions.
     pub new_velocity: Vec<SVector<f64, D>>,
-    /// Per segment of [`LIVE_SEGMENT`] nodes: whether it may hold non-zero values this
-    /// step. The others hold zeros in every field (every writer leaves a node without
-    /// mass at zero), so P2G's merge and the grid update skip them: a body in a large box
-    /// of empty nodes does not pay for the box.
+    /// Per segment of [`crate::scatter::LIVE_SEGMENT`] nodes: whether it may hold
+    /// non-zero values this step. The others hold zeros in every field (every writer
+    /// leaves a node without mass at zero), so P2G's merge and the grid update skip them:
+    /// a body in a large box of empty nodes does not pay for the box.
     pub live: Vec<bool>,
     /// Contributions below this mass are round-off (10⁻¹² of the heaviest particle).
     pub round_off_mass: f64,
@@ -272,14 +272,7 @@ impl<const D: usize> Grid<D> {
                         (0.0, SVector::<f64, D>::zeros(), 0usize, 0.0);
                     // A segment no particle reached, now or in the last step, is zero
                     // (its nodes would add zeros to the sums).
-                    let live_nodes =
-                        live.iter()
-                            .enumerate()
-                            .filter(|(_, l)| **l)
-                            .flat_map(|(s, _)| {
-                                s * LIVE_SEGMENT..mass.len().min((s + 1) * LIVE_SEGMENT)
-                            });
-                    for i in live_nodes {
+                    for i in live_ranges(live, mass.len()).flatten() {
                         let m = mass[i];
                         // The zero arrays of a momentum-only scatter are not read: the
                         // same values, less memory traffic.

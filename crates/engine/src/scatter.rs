@@ -505,6 +505,19 @@ pub(crate) fn live_segments(nodes: usize) -> usize {
     nodes.div_ceil(LIVE_SEGMENT)
 }
 
+/// The node ranges of a chunk's live segments, given the chunk's flags (`live`, one per
+/// segment) and its `nodes` (the last chunk may end inside a segment), counted from the
+/// chunk's first node, in increasing order.
+pub(crate) fn live_ranges(
+    live: &[bool],
+    nodes: usize,
+) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+    live.iter()
+        .enumerate()
+        .filter(|(_, l)| **l)
+        .map(move |(s, _)| s * LIVE_SEGMENT..nodes.min((s + 1) * LIVE_SEGMENT))
+}
+
 /// The particle order, the blocks and their windows, reused from step to step.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Scatter<const D: usize> {
@@ -729,8 +742,7 @@ fn merge_chunk<const D: usize, R: Record<D>>(
     if !live.iter().any(|&l| l) {
         return;
     }
-    for (s, _) in live.iter().enumerate().filter(|(_, l)| **l) {
-        let range = s * LIVE_SEGMENT..chunk.mass.len().min((s + 1) * LIVE_SEGMENT);
+    for range in live_ranges(live, chunk.mass.len()) {
         R::clear(&mut chunk.part(range));
     }
     let start = c * NODE_CHUNK;
