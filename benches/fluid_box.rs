@@ -46,6 +46,8 @@ fn scene<K: Kernel<3>, T: TransferScheme>(
     let mut settings = StepSettings::new(2e-4);
     settings.stencil_storage = storage;
     settings.gravity = Vector3::new(0.0, -9.8, 0.0);
+    // As the scene file: the particles stored in P2G's order every 20 steps.
+    settings.particle_sort_interval = 20;
     let mut sim =
         Simulation::new(kernel, material, transfer, particles(), settings).expect("valid");
     for axis in 0..3 {

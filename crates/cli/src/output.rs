@@ -102,7 +102,7 @@ impl OutputDir {
                     .out_of_plane_stress(f, state)
                     .map_err(|source| umls_engine::EngineError::Material {
                         step: sim.step_count(),
-                        particle: i,
+                        particle: sim.particle_id(i),
                         source,
                     })?;
                 tau_zz / j
@@ -123,6 +123,14 @@ impl OutputDir {
         grid.add_point_field("deformation_gradient", 9, deformation)?;
         grid.add_point_field("jacobian", 1, jacobian)?;
         grid.add_point_field("mass", 1, p.mass.clone())?;
+        // The particle's index in the scene: sorting moves particles between slots, so the
+        // point order of two frames may differ.
+        grid.add_point_ids(
+            "id",
+            (0..p.len())
+                .map(|slot| i32::try_from(sim.particle_id(slot)).unwrap_or(i32::MAX))
+                .collect(),
+        )?;
         grid.add_point_ids(
             "material",
             p.state.iter().map(|s| i32::from(s.material)).collect(),

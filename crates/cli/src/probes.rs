@@ -17,7 +17,10 @@ use crate::scene::Scene;
 /// The particles followed.
 #[derive(Debug, Clone, Default)]
 pub struct Probes {
+    /// Their indices in the scene.
     particles: Vec<usize>,
+    /// Where the simulation stores them (their indices until the particles are sorted).
+    slots: Vec<usize>,
 }
 
 impl Probes {
@@ -43,7 +46,18 @@ impl Probes {
                 None => return Err(scene.value_error("output.probes", "the scene has no particle")),
             }
         }
-        Ok(Self { particles })
+        Ok(Self {
+            slots: particles.clone(),
+            particles,
+        })
+    }
+
+    /// Follows the probes' particles to the slots a sort moved them to: `slot_of[i]` is
+    /// where the scene's particle i is stored now.
+    pub fn follow(&mut self, slot_of: &[usize]) {
+        for (slot, &i) in self.slots.iter_mut().zip(&self.particles) {
+            *slot = slot_of[i];
+        }
     }
 
     /// Number of probes.
@@ -67,7 +81,8 @@ impl Probes {
             .collect()
     }
 
-    /// Displacement of probe `k` in the scene frame.
+    /// Displacement of probe `k` in the scene frame; `initial` and `positions` are in
+    /// the simulation's storage order.
     pub fn displacement<const D: usize>(
         &self,
         k: usize,
@@ -75,7 +90,7 @@ impl Probes {
         initial: &[SVector<f64, D>],
         positions: &[SVector<f64, D>],
     ) -> SVector<f64, D> {
-        let i = self.particles[k];
+        let i = self.slots[k];
         frame.rotation.transpose() * (positions[i] - initial[i])
     }
 }

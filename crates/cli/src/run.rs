@@ -569,6 +569,7 @@ fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     settings.gravity_ramp = ctx.setup.gravity_ramp;
     settings.stress_update = ctx.setup.stress_update;
     settings.stencil_storage = ctx.scene.spec.kernel.stencils.storage();
+    settings.particle_sort_interval = ctx.scene.spec.kernel.particle_sort_interval;
     settings.mass_matrix = crate::schema::MassSpec::matrix(ctx.scene.spec.transfer.mass);
     settings.damping = ctx.setup.damping;
     let mut sim = Simulation::new(kernel, table, transfer, particles, settings)?;
@@ -625,6 +626,10 @@ pub(crate) trait Run<const D: usize> {
     fn boundary(&mut self) -> &mut Boundary<D>;
     fn positions(&self) -> &[SVector<f64, D>];
     fn velocities(&self) -> &[SVector<f64, D>];
+    /// The scene's index of the particle stored in `slot` (sorting moves particles).
+    fn particle_id(&self, slot: usize) -> usize;
+    /// How many times the particles have been sorted.
+    fn particle_sorts(&self) -> usize;
     fn write_particles(&self, out: &mut OutputDir, reference: &[SVector<f64, D>]) -> Result<()>;
     fn grid(&self) -> (&[f64], &[SVector<f64, D>]);
     fn node_positions(&self) -> Vec<SVector<f64, D>>;
@@ -700,6 +705,12 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
     fn velocities(&self) -> &[SVector<f64, D>] {
         &self.particles().velocity
     }
+    fn particle_id(&self, slot: usize) -> usize {
+        Simulation::particle_id(self, slot)
+    }
+    fn particle_sorts(&self) -> usize {
+        Simulation::particle_sorts(self)
+    }
     fn write_particles(&self, out: &mut OutputDir, reference: &[SVector<f64, D>]) -> Result<()> {
         out.write_particles(self, reference)
     }
@@ -761,6 +772,23 @@ fn total_energy<const D: usize>(d: &Diagnostics<D>) -> (f64, f64) {
     (-d.external_work, d.energy_balance())
 }
 
+/// After a particle sort: the seeds' positions in the new storage order, and the probes'
+/// particles where they are stored now.
+fn follow_sorted<const D: usize>(
+    sim: &dyn Run<D>,
+    seeds: &[SVector<f64, D>],
+    reference_positions: &mut [SVector<f64, D>],
+    probes: &mut Probes,
+) {
+    let mut slot_of = vec![0; seeds.len()];
+    for (slot, x) in reference_positions.iter_mut().enumerate() {
+        let id = sim.particle_id(slot);
+        *x = seeds[id];
+        slot_of[id] = slot;
+    }
+    probes.follow(&slot_of);
+}
+
 /// The run loop: time step, boundaries, output, history, summary.
 fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<RunReport> {
     let (scene, setup, spec) = (ctx.scene, &ctx.setup, &ctx.scene.spec);
@@ -779,7 +807,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     }
 
     let mut out = OutputDir::create(&ctx.options.out, ctx.encoding)?;
-    let probes = Probes::new(scene, &setup.frame, &seeds.position)?;
+    let mut probes = Probes::new(scene, &setup.frame, &seeds.position)?;
     // The measured wall: its nodes' positions, and where its reactions start among all
     // reaction-set nodes.
     let mut wall_pressure = setup.pressure.map(|(boundary, centre, area)| {
@@ -805,7 +833,10 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut history = HistoryWriter::create(out.path("history.csv"), &header_refs)?;
 
-    let reference_positions = seeds.position.clone();
+    // Where each stored particle started: the seeds, in the simulation's storage order
+    // (which a particle sort changes; `follow_sorted`).
+    let mut reference_positions = seeds.position.clone();
+    let mut sorts = sim.particle_sorts();
     let frames = setup::frame_count(scene, ctx.end_time);
     let frame_time = |k: usize| ctx.end_time * k as f64 / (frames - 1) as f64;
     let mut next_frame = 1;
@@ -814,14 +845,15 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     let mut probe_error = 0.0f64;
     let mut record = |sim: &dyn Run<D>,
                       history: &mut HistoryWriter,
-                      error: Option<f64>|
+                      error: Option<f64>,
+                      (reference_positions, probes): (&[SVector<f64, D>], &Probes)|
      -> Result<(f64, Diagnostics<D>, EnergyRecord)> {
         let d = sim.diagnostics()?;
         let (potential, total) = total_energy(&d);
         let displacement = reference::displacement_error(
             scene,
             setup,
-            &reference_positions,
+            reference_positions,
             sim.positions(),
             sim.time(),
         )?;
@@ -829,7 +861,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         let mut row = history_row(&d, potential, total, error);
         row.extend(displacement);
         for k in 0..probes.len() {
-            let u = probes.displacement(k, &setup.frame, &reference_positions, sim.positions());
+            let u = probes.displacement(k, &setup.frame, reference_positions, sim.positions());
             row.extend(u.iter());
             if let Some(reference) = setup.probe_reference.as_ref().filter(|r| r.probe == k) {
                 if let Some(exact) = reference.at(sim.time()) {
@@ -861,11 +893,11 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         Ok((total, d, record))
     };
 
-    let reference_error = |sim: &dyn Run<D>| {
+    let reference_error = |sim: &dyn Run<D>, reference_positions: &[SVector<f64, D>]| {
         reference::velocity_error(
             scene,
             setup,
-            &reference_positions,
+            reference_positions,
             sim.velocities(),
             sim.time(),
             if sim.step_count() > 0 {
@@ -877,7 +909,12 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
     };
 
     sim.write_particles(&mut out, &reference_positions)?;
-    let (e0, d0, r0) = record(&*sim, &mut history, reference_error(&*sim)?)?;
+    let (e0, d0, r0) = record(
+        &*sim,
+        &mut history,
+        reference_error(&*sim, &reference_positions)?,
+        (&reference_positions, &probes),
+    )?;
     let mut energies = vec![r0];
     // Energy error: the largest |E(t) − E(0)| over the largest mechanical energy
     // (kinetic + elastic) of the run, which stays meaningful when E(0) is 0 (a body
@@ -920,14 +957,24 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
             failure = Some(e.into());
             break;
         }
-        let error = reference_error(&*sim)?;
+        if sim.particle_sorts() != sorts {
+            sorts = sim.particle_sorts();
+            follow_sorted(
+                &*sim,
+                &seeds.position,
+                &mut reference_positions,
+                &mut probes,
+            );
+        }
+        let error = reference_error(&*sim, &reference_positions)?;
         if let Some(e) = error {
             error_sum += e * e;
             error_max = error_max.max(e);
         }
         let last_step = sim.time() >= ctx.end_time * (1.0 - 1e-12);
         if step % spec.output.history_every == 0 || last_step {
-            let (total, d, r) = record(&*sim, &mut history, error)?;
+            let (total, d, r) =
+                record(&*sim, &mut history, error, (&reference_positions, &probes))?;
             max_wave_courant = max_wave_courant.max(d.wave_courant);
             energies.push(r);
             energy_change = energy_change.max((total - e0).abs());
@@ -951,7 +998,9 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         if let Err(e) = sim.write_particles(&mut out, &reference_positions) {
             warnings.push(format!("the state the run stopped in has no frame: {e}"));
         }
-        if let Ok((total, d, r)) = record(&*sim, &mut history, None) {
+        if let Ok((total, d, r)) =
+            record(&*sim, &mut history, None, (&reference_positions, &probes))
+        {
             energies.push(r);
             last_total = total;
             last = d;
@@ -1052,6 +1101,8 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         "transfer": transfer_name(&spec.transfer),
         "stress_update": spec.time.stress_update.name(),
         "stencils": spec.kernel.stencils.name(),
+        "particle_sort_interval": spec.kernel.particle_sort_interval,
+        "particle_sorts": sim.particle_sorts(),
         "materials": setup.material_names,
         "particles": sim.positions().len(),
         "nodes": sim.node_count(),

@@ -279,6 +279,12 @@ pub struct KernelSpec {
     /// kernel's choice, `auto`).
     #[serde(default)]
     pub stencils: StencilsSpec,
+    /// Every this many steps, store the particles in the order P2G visits them (by the
+    /// lowest node of their stencils), so the transfers read them nearly sequentially;
+    /// 0 (default) never sorts. The results are the same bit for bit; outputs follow
+    /// each particle by its index in the scene.
+    #[serde(default)]
+    pub particle_sort_interval: usize,
 }
 
 /// `kernel.stencils`.

@@ -14,7 +14,7 @@ pub enum EngineError {
     Kernel {
         /// Step number.
         step: usize,
-        /// Particle index.
+        /// Particle index (at construction: [`crate::Simulation::particle_id`]).
         particle: usize,
         /// The kernel's error.
         source: KernelError,
@@ -24,7 +24,7 @@ pub enum EngineError {
     Material {
         /// Step number.
         step: usize,
-        /// Particle index.
+        /// Particle index (at construction: [`crate::Simulation::particle_id`]).
         particle: usize,
         /// The model's error.
         source: ConstitutiveError,
@@ -38,7 +38,7 @@ pub enum EngineError {
         field: &'static str,
         /// "particle" or "node".
         entity: &'static str,
-        /// Its index.
+        /// Its index (a particle's at construction: [`crate::Simulation::particle_id`]).
         index: usize,
     },
     /// det F ≤ 0 after the deformation update.
@@ -46,7 +46,7 @@ pub enum EngineError {
     Inverted {
         /// Step number.
         step: usize,
-        /// Particle index.
+        /// Particle index (at construction: [`crate::Simulation::particle_id`]).
         particle: usize,
         /// det F.
         det: f64,
@@ -74,7 +74,7 @@ pub enum EngineError {
     Unstable {
         /// Step number.
         step: usize,
-        /// The fastest particle.
+        /// The fastest particle (its index at construction).
         particle: usize,
         /// Its Courant number |v| Δt / h.
         courant: f64,
@@ -98,7 +98,7 @@ pub enum EngineError {
     /// The initial stress could not be imposed on a particle.
     #[error("particle {particle}: cannot impose the initial stress: {reason}")]
     InitialStress {
-        /// Particle index.
+        /// Particle index (at construction: [`crate::Simulation::particle_id`]).
         particle: usize,
         /// Why.
         reason: &'static str,
@@ -126,6 +126,67 @@ pub enum EngineError {
 }
 
 impl EngineError {
+    /// The error with the particle it names (a storage slot) given by `id` instead.
+    #[cold]
+    pub(crate) fn naming_particle_by(self, id: impl Fn(usize) -> usize) -> Self {
+        match self {
+            Self::Kernel {
+                step,
+                particle,
+                source,
+            } => Self::Kernel {
+                step,
+                particle: id(particle),
+                source,
+            },
+            Self::Material {
+                step,
+                particle,
+                source,
+            } => Self::Material {
+                step,
+                particle: id(particle),
+                source,
+            },
+            Self::NonFinite {
+                step,
+                field,
+                entity: "particle",
+                index,
+            } => Self::NonFinite {
+                step,
+                field,
+                entity: "particle",
+                index: id(index),
+            },
+            Self::Inverted {
+                step,
+                particle,
+                det,
+            } => Self::Inverted {
+                step,
+                particle: id(particle),
+                det,
+            },
+            Self::Unstable {
+                step,
+                particle,
+                courant,
+                limit,
+            } => Self::Unstable {
+                step,
+                particle: id(particle),
+                courant,
+                limit,
+            },
+            Self::InitialStress { particle, reason } => Self::InitialStress {
+                particle: id(particle),
+                reason,
+            },
+            other => other,
+        }
+    }
+
     /// A short name of the kind of failure, for tables and stability maps: `kernel`,
     /// `material`, `non-finite`, `inverted`, `energy-blow-up`, `too-fast`,
     /// `time-step-too-large`, `initial-stress`, `invalid-parameter` or `unsupported`.

@@ -67,9 +67,21 @@ impl FittedClamp {
         &self.nodes
     }
 
-    /// The particles held at rest.
+    /// The particles held at rest (their slots in [`crate::Simulation::particles`],
+    /// ascending as given; a particle sort renumbers them in place).
     pub fn particles(&self) -> &[u32] {
         &self.particles
+    }
+
+    /// Follows the particles to the slots a sort moved them to (`slot[old] = new`;
+    /// indices beyond it name no particle and stay, for the step to report). The list
+    /// keeps its order, so the fit sums its rows as before and gives the same bits.
+    pub(crate) fn renumber(&mut self, slot: &[u32]) {
+        for p in &mut self.particles {
+            if let Some(&new) = slot.get(*p as usize) {
+                *p = new;
+            }
+        }
     }
 
     /// The least-squares system of this step's clamped-particle stencils `rows`: the

@@ -15,7 +15,11 @@
 //! step, energy growing beyond what gravity and body forces put in.
 //!
 //! Parallel work is split into fixed chunks and every sum is taken in particle order, so
-//! results are bitwise identical for any number of threads.
+//! results are bitwise identical for any number of threads. With
+//! [`StepSettings::particle_sort_interval`] the engine stores the particles in P2G's
+//! order now and then (faster transfers as the particles mix); that moves particles
+//! between slots, not the results: [`Simulation::particle_id`] names a slot's particle
+//! by its index at construction, and body forces and errors use that index.
 //!
 //! ```
 //! use nalgebra::SVector;

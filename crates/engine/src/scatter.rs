@@ -521,7 +521,8 @@ pub(crate) fn live_ranges(
 /// The particle order, the blocks and their windows, reused from step to step.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Scatter<const D: usize> {
-    keys: Vec<(u32, u32)>,
+    /// Per particle: the lowest node of its stencil, its id (the tie-break) and its slot.
+    keys: Vec<(u32, u32, u32)>,
     order: Vec<u32>,
     /// Start of each block in `order` (and its end, last).
     bounds: Vec<usize>,
@@ -548,31 +549,60 @@ impl<const D: usize> Scatter<D> {
         )
     }
 
-    /// Orders the particles by the lowest node of their stencil and cuts them into
+    /// The last scatter's particle order (empty before the first).
+    pub fn order(&self) -> &[u32] {
+        &self.order
+    }
+
+    /// Takes the last scatter's order, for storing the particles in it
+    /// ([`Self::restore_sorted_order`] gives the buffer back).
+    pub fn take_order(&mut self) -> Vec<u32> {
+        std::mem::take(&mut self.order)
+    }
+
+    /// Gives back the buffer of [`Self::take_order`] once the particles are stored in
+    /// that order, which is then the identity.
+    pub fn restore_sorted_order(&mut self, mut order: Vec<u32>) {
+        let n = order.len() as u32;
+        order.clear();
+        order.extend(0..n);
+        self.order = order;
+    }
+
+    /// Orders the particles by the lowest node of their stencil, ties by their ids
+    /// (`ids[p]`, or p beyond them: the index a particle had before any sort, so that the
+    /// order does not depend on where the particles are stored), and cuts them into
     /// blocks; `ranges` holds each particle's lowest and highest node, which on a
     /// `lattice` are the corners of the box its stencil covers.
-    fn plan(&mut self, ranges: &[(u32, u32)], nodes: usize, lattice: Option<&Lattice<D>>) {
+    fn plan(
+        &mut self,
+        ranges: &[(u32, u32)],
+        ids: &[u32],
+        nodes: usize,
+        lattice: Option<&Lattice<D>>,
+    ) {
         let particles = ranges.len();
+        let key = |p: u32| {
+            (
+                ranges[p as usize].0,
+                ids.get(p as usize).copied().unwrap_or(p),
+                p,
+            )
+        };
         self.keys.clear();
         if self.order.len() == particles {
             // In the last step's order, which particles that moved a little keep nearly
             // sorted: the merge sort below finds the sorted runs and has little to do.
-            let order = &self.order;
-            self.keys
-                .par_extend(order.par_iter().map(|&p| (ranges[p as usize].0, p)));
+            self.keys.par_extend(self.order.par_iter().map(|&p| key(p)));
         } else {
-            self.keys.par_extend(
-                ranges
-                    .par_iter()
-                    .enumerate()
-                    .map(|(p, &(lo, _))| (lo, p as u32)),
-            );
+            self.keys
+                .par_extend((0..particles as u32).into_par_iter().map(key));
         }
-        // Keys are unique (the index breaks ties), so the order they end in depends on
-        // the keys alone, not on where the sort started.
+        // Keys are unique (the id breaks ties), so the order they end in depends on the
+        // keys alone, not on where the sort started.
         self.keys.par_sort();
         self.order.clear();
-        self.order.extend(self.keys.iter().map(|&(_, p)| p));
+        self.order.extend(self.keys.iter().map(|&(_, _, p)| p));
         let order = &self.order;
         let range = |b: &[usize]| {
             let block = order[b[0]..b[1]].iter().map(|&p| ranges[p as usize]);
@@ -633,14 +663,16 @@ impl<const D: usize> Scatter<D> {
     /// one block's particles in order, and sums the windows into `sums` (every node of a
     /// live chunk written, nodes no particle touches with zero; chunks neither reached
     /// now nor in the last step are zero already and are skipped; the same per segment
-    /// of a chunk). `ranges` holds each particle's lowest and highest stencil node. Given the kernel's `lattice`, the
-    /// windows are boxes of it, and `contribute` must add through
+    /// of a chunk). `ranges` holds each particle's lowest and highest stencil node, `ids`
+    /// the particles' ids ([`Self::plan`]; empty: their slots). Given the kernel's
+    /// `lattice`, the windows are boxes of it, and `contribute` must add through
     /// [`Window::place`]'s records (tensor-product stencils). Among failing blocks the
     /// lowest particle index wins, whatever the thread count; on failure `sums` is left
     /// as it was.
     pub fn scatter<F, E>(
         &mut self,
         ranges: &[(u32, u32)],
+        ids: &[u32],
         sums: NodalSums<'_, D>,
         lattice: Option<&Lattice<D>>,
         contribute: F,
@@ -651,7 +683,7 @@ impl<const D: usize> Scatter<D> {
     {
         let nodes = sums.mass.len();
         let (momentum_only, nonnegative) = (sums.momentum_only, sums.nonnegative);
-        self.plan(ranges, nodes, lattice);
+        self.plan(ranges, ids, nodes, lattice);
         let blocks = self.bounds.len() - 1;
         self.windows.resize_with(blocks, Window::default);
         let (order, bounds, block_ranges) = (&self.order, &self.bounds, &self.ranges);
@@ -877,7 +909,7 @@ mod tests {
                     };
                     let on = boxed.then_some(&lattice);
                     scatters[g]
-                        .scatter(&ranges, sums, on, |block, window| {
+                        .scatter(&ranges, &[], sums, on, |block, window| {
                             for &p in block {
                                 let c = corners[p as usize];
                                 let first = lattice.index(&c);

@@ -24,13 +24,14 @@ mod fitted_clamps;
 mod grid_to_particles;
 mod mass_matrix;
 mod musl;
+mod particle_sort;
 mod particles_to_grid;
 mod tensor_rows;
 
 /// A body acceleration b(p, x, t), added to gravity: called with the particle's index p
-/// (its place in [`Simulation::particles`], which the engine never reorders), its
-/// current position x and the time. The index lets a field depend on where the particle
-/// started: a manufactured solution's force is a function of the reference position X,
+/// (its place in [`Simulation::particles`] when the simulation was built, which sorting
+/// does not change: [`Simulation::particle_id`]), its current position x and the time.
+/// The index lets a field depend on where the particle started: a manufactured solution's force is a function of the reference position X,
 /// and evaluated at the current position instead it acts on a particle that drifts off
 /// the exact motion with the force meant for another place (the `vortex` scene's rim
 /// particles were pushed further out by it, docs/scenes.md).
@@ -125,6 +126,11 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     clamp_systems: Vec<crate::fitted_clamp::ClampSystem<D>>,
     /// Buffers of the mass-matrix iterations (empty without them).
     mass_solve: mass_matrix::MassSolve<D>,
+    /// Per stored particle, its index at construction (empty until the first sort:
+    /// [`Self::particle_id`]).
+    ids: Vec<u32>,
+    /// How many times the particles have been sorted.
+    sorts: usize,
 }
 
 /// Checks a number setting.
@@ -255,11 +261,15 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             reactions: Default::default(),
             clamp_systems: Vec::new(),
             mass_solve: Default::default(),
+            ids: Vec::new(),
+            sorts: 0,
             grid,
         })
     }
 
-    /// The particles.
+    /// The particles, in storage order: the order they were given in, unless
+    /// [`StepSettings::particle_sort_interval`] sorts them ([`Self::particle_id`] gives a
+    /// slot's index at construction).
     pub fn particles(&self) -> &Particles<D, M::State, K::Cache> {
         &self.particles
     }
@@ -316,7 +326,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 + bytes(&p.volume)
                 + bytes(&p.mass)
                 + bytes(&p.state)
-                + bytes(&p.cache),
+                + bytes(&p.cache)
+                + bytes(&self.ids),
             particle_scratch: bytes(&self.stress_buffer)
                 + bytes(&self.body_accelerations)
                 + ranges
@@ -407,7 +418,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     .kirchhoff_stress(&p.deformation[i], &p.state[i])
                     .map_err(|source| EngineError::Material {
                         step: self.step,
-                        particle: i,
+                        particle: self.particle_id(i),
                         source,
                     })
             })
@@ -494,7 +505,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 let target = geostatic::geostatic_stress(&g, density, depths[i], k0);
                 geostatic::prestrain(material, &p.state[i], &target).ok_or(
                     EngineError::InitialStress {
-                        particle: i,
+                        particle: self.particle_id(i),
                         reason: "the material cannot carry this stress (Newton's method did not converge)",
                     },
                 )
@@ -508,8 +519,24 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     }
 
     /// One explicit step: locate and evaluate stencils, P2G, grid update with boundary
-    /// conditions, G2P, walls, deformation and stress update, failure checks.
+    /// conditions, G2P, walls, deformation and stress update, failure checks (after
+    /// storing the particles in P2G's order when
+    /// [`StepSettings::particle_sort_interval`] says so). An error names a particle by
+    /// its index at construction ([`Self::particle_id`]).
     pub fn step(&mut self) -> Result<(), EngineError> {
+        if self.sort_due() {
+            let mut clock = Lap::start();
+            self.sort_particles();
+            self.times.stencils += clock.lap();
+        }
+        self.advance()
+            .map_err(|e| e.naming_particle_by(|slot| self.particle_id(slot)))
+    }
+
+    /// [`Self::step`] without the sort, naming particles by their slots (compiled into
+    /// `step`, as the stages were before the sort wrapped them).
+    #[inline(always)]
+    fn advance(&mut self) -> Result<(), EngineError> {
         let step = self.step;
         // The kernel and settings are public fields: a combination the transfer cannot
         // work with may have been set since construction.

@@ -47,8 +47,9 @@ fn bspline_particles_stay_within_400_bytes_and_stored_stencils_are_the_differenc
     // The state alone: x, v (24 B each), C, F (72 B each), C's moment, V⁰, m (8 B each).
     assert!(recomputed.particles >= recomputed.particle_count * 216);
     // A step's scratch: the stresses (72 B; G2P leaves the velocity gradients in
-    // their slots), the node range (8 B) and the P2G order (12 B, its key vector growing
-    // by doubling), not a velocity-gradient buffer besides.
+    // their slots), the node range (8 B) and the P2G order (16 B: each particle's node,
+    // id and slot as its sort key, and the order; the key vector grows by doubling), not
+    // a velocity-gradient buffer besides.
     let scratch = recomputed.particle_scratch as f64 / recomputed.particle_count as f64;
     assert!((92.0..120.0).contains(&scratch), "{scratch} B of scratch");
     let stored = memory(grid, 0.02, StencilStorage::Store);

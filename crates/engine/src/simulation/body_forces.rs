@@ -19,7 +19,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             self.body_accelerations.clear();
             return;
         };
-        let (position, time) = (&self.particles.position, self.time);
+        let (position, time, ids) = (&self.particles.position, self.time, &self.ids);
         let chunk = crate::stencils::CHUNK;
         self.body_accelerations
             .resize(position.len(), nalgebra::SVector::zeros());
@@ -29,7 +29,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .for_each(|(c, accelerations)| {
                 for (k, a) in accelerations.iter_mut().enumerate() {
                     let i = c * chunk + k;
-                    *a = body_force(i, &position[i], time);
+                    // b is a function of the particle's index at construction.
+                    let id = ids.get(i).map_or(i, |&id| id as usize);
+                    *a = body_force(id, &position[i], time);
                 }
             });
     }

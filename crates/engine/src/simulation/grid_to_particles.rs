@@ -194,6 +194,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             new: &self.grid.new_velocity,
         };
         let p = &mut self.particles;
+        let mass = &p.mass;
         let (gravity, step) = (self.settings.gravity_at(self.time), self.step);
         let body = &self.body_accelerations;
         let boundary = &self.boundary;
@@ -217,6 +218,13 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .enumerate()
             .map(
                 |(c, (((((velocity, position), affine), moment), gradient), cache))| {
+                    // The chunk's slices at one length, so the loop below indexes them
+                    // without a bounds check per particle and array.
+                    let n = velocity.len();
+                    let (position, affine, moment) =
+                        (&mut position[..n], &mut affine[..n], &mut moment[..n]);
+                    let (gradient, cache) = (&mut gradient[..n], &mut cache[..n]);
+                    let mass = &mass[c * chunk..c * chunk + n];
                     let mut scratch = Stencil::new();
                     // Work of gravity and body forces with the mean of old and new velocity:
                     // the trapezoidal rule balances the kinetic energy of a free fall exactly.
@@ -231,7 +239,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     // in cache instead of in a serial pass after the step.
                     let mut fastest = (0, 0.0f64);
                     let mut non_finite = None;
-                    for k in 0..velocity.len() {
+                    for k in 0..n {
                         let i = c * chunk + k;
                         let x = position[k];
                         let u = gather(
@@ -247,7 +255,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                             dt,
                         )?;
                         let acceleration = body.get(i).map_or(gravity, |b| gravity + b);
-                        power += p.mass[i] * acceleration.dot(&(velocity[k] + u.velocity)) * 0.5;
+                        power += mass[k] * acceleration.dot(&(velocity[k] + u.velocity)) * 0.5;
                         let moved = (u.position - x).norm_squared();
                         if moved > longest.1 {
                             longest = (i, moved);

@@ -134,8 +134,13 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         jacobi(&mut solve.velocity, None);
         let boundary = &self.boundary;
         boundary.apply(&mut solve.velocity);
-        let (p, kernel, stencils, transfer) =
-            (&self.particles, &self.kernel, &self.stencils, self.transfer);
+        let (p, kernel, stencils, transfer, ids) = (
+            &self.particles,
+            &self.kernel,
+            &self.stencils,
+            self.transfer,
+            &self.ids,
+        );
         let moment_scale = kernel.constant_second_moment();
         for _ in 0..iterations {
             let velocity = &solve.velocity;
@@ -152,7 +157,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             };
             solve
                 .scatter
-                .scatter(stencils.ranges(), sums, None, |block, window| {
+                .scatter(stencils.ranges(), ids, sums, None, |block, window| {
                     let mut scratch = Stencil::new();
                     for &i in block {
                         let i = i as usize;
