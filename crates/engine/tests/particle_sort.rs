@@ -12,6 +12,7 @@ use umls_engine::{
     TransferScheme, lattice_samples,
 };
 use umls_kernels::{BSplineKernel, BSplineOrder, Umls2};
+use umls_mesh::SimplexMesh;
 use umls_mesh::generate::{Diagonal, Lattice};
 use umls_transfer::Kernel;
 
@@ -140,15 +141,29 @@ where
     moved
 }
 
-#[test]
-fn sorted_particles_give_the_unsorted_bits() {
-    let grid = BSplineKernel::new(
+/// Quadratic B-splines of spacing 0.025 over [−0.1, 1.1]².
+fn quadratic_grid() -> BSplineKernel<2> {
+    BSplineKernel::new(
         Vector2::new(-0.1, -0.1),
         0.025,
         [48, 48],
         BSplineOrder::Quadratic,
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// The unit square in `cells` × `cells` cells, alternating diagonals.
+fn triangles(cells: usize) -> Arc<SimplexMesh<2>> {
+    Arc::new(
+        Lattice::new([0.0, 0.0], [1.0, 1.0], [cells, cells])
+            .triangles(Diagonal::Alternating)
+            .unwrap(),
+    )
+}
+
+#[test]
+fn sorted_particles_give_the_unsorted_bits() {
+    let grid = quadratic_grid();
     // 10,000 particles: P2G scatters in several parallel blocks.
     let moved = assert_sorting_changes_no_bit("bspline2, APIC", grid, Apic, 0.004, 12);
     assert!(
@@ -167,11 +182,7 @@ fn sorted_particles_give_the_unsorted_bits() {
         moved > 4000,
         "bspline2 3D: the sorts moved only {moved} particles"
     );
-    let mesh = Arc::new(
-        Lattice::new([0.0, 0.0], [1.0, 1.0], [40, 40])
-            .triangles(Diagonal::Alternating)
-            .unwrap(),
-    );
+    let mesh = triangles(40);
     let moved = assert_sorting_changes_no_bit(
         "umls, FLIP",
         Umls2::new(mesh),
@@ -186,11 +197,7 @@ fn sorted_particles_give_the_unsorted_bits() {
 /// same particles and the run keeps its bits.
 #[test]
 fn a_fitted_clamp_follows_its_particles_through_the_sorts() {
-    let mesh = Arc::new(
-        Lattice::new([0.0, 0.0], [1.0, 1.0], [20, 20])
-            .triangles(Diagonal::Alternating)
-            .unwrap(),
-    );
+    let mesh = triangles(20);
     let run = |interval: usize| {
         let mut sim = simulation(
             Umls2::new(mesh.clone()),
@@ -233,13 +240,7 @@ fn a_fitted_clamp_follows_its_particles_through_the_sorts() {
 /// construction, not by the slot it sits in.
 #[test]
 fn an_error_names_the_particle_by_its_index_at_construction() {
-    let grid = BSplineKernel::new(
-        Vector2::new(-0.1, -0.1),
-        0.025,
-        [48, 48],
-        BSplineOrder::Quadratic,
-    )
-    .unwrap();
+    let grid = quadratic_grid();
     let mut sim = simulation(grid, Apic, 0.004, 2);
     for _ in 0..4 {
         sim.step().unwrap();
