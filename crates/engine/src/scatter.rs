@@ -585,7 +585,7 @@ impl<const D: usize> Scatter<D> {
         let key = |p: u32| {
             (
                 ranges[p as usize].0,
-                ids.get(p as usize).copied().unwrap_or(p),
+                crate::simulation::id_in(ids, p as usize) as u32,
                 p,
             )
         };

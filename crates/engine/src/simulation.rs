@@ -25,16 +25,18 @@ mod grid_to_particles;
 mod mass_matrix;
 mod musl;
 mod particle_sort;
+pub(crate) use particle_sort::id_in;
 mod particles_to_grid;
 mod tensor_rows;
 
 /// A body acceleration b(p, x, t), added to gravity: called with the particle's index p
 /// (its place in [`Simulation::particles`] when the simulation was built, which sorting
 /// does not change: [`Simulation::particle_id`]), its current position x and the time.
-/// The index lets a field depend on where the particle started: a manufactured solution's force is a function of the reference position X,
-/// and evaluated at the current position instead it acts on a particle that drifts off
-/// the exact motion with the force meant for another place (the `vortex` scene's rim
-/// particles were pushed further out by it, docs/scenes.md).
+/// The index lets a field depend on where the particle started: a manufactured
+/// solution's force is a function of the reference position X, and evaluated at the
+/// current position instead it acts on a particle that drifts off the exact motion with
+/// the force meant for another place (the `vortex` scene's rim particles were pushed
+/// further out by it, docs/scenes.md).
 pub type BodyForce<const D: usize> =
     std::sync::Arc<dyn Fn(usize, &SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync>;
 

@@ -30,8 +30,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 for (k, a) in accelerations.iter_mut().enumerate() {
                     let i = c * chunk + k;
                     // b is a function of the particle's index at construction.
-                    let id = ids.get(i).map_or(i, |&id| id as usize);
-                    *a = body_force(id, &position[i], time);
+                    *a = body_force(super::id_in(ids, i), &position[i], time);
                 }
             });
     }

@@ -51,8 +51,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let first_new = self.ids.len().min(n);
         self.ids.truncate(n);
         self.ids.extend(first_new as u32..n as u32);
-        let ids = std::mem::take(&mut self.ids);
-        self.ids = order.par_iter().map(|&p| ids[p as usize]).collect();
+        gather(&mut self.ids, &order, &mut Vec::new());
         let p = &mut self.particles;
         // One scratch vector per element type: each gather leaves the old storage there
         // for the next array of that type, so a sort allocates one array of each (the
@@ -95,6 +94,12 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     /// through [`Self::particles_mut`]): sorting
     /// ([`crate::StepSettings::particle_sort_interval`]) moves particles between slots.
     pub fn particle_id(&self, slot: usize) -> usize {
-        self.ids.get(slot).map_or(slot, |&id| id as usize)
+        id_in(&self.ids, slot)
     }
+}
+
+/// The id of the particle in `slot` given the simulation's `ids` (a slot beyond them,
+/// where no sort has run or a particle was added since, is its own id).
+pub(crate) fn id_in(ids: &[u32], slot: usize) -> usize {
+    ids.get(slot).map_or(slot, |&id| id as usize)
 }

@@ -116,6 +116,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let (stencils, kernel, time, step) = (&self.stencils, &self.kernel, self.time, self.step);
         let gravity = self.settings.gravity_at(time);
         let body = &self.body_accelerations;
+        let ids = &self.ids;
         let g = &mut self.grid;
         let sums = crate::scatter::NodalSums {
             mass: &mut g.mass,
@@ -146,102 +147,94 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .and(kernel.node_lattice())
             .map(crate::scatter::Lattice::new);
         self.scatter
-            .scatter(
-                ranges,
-                &self.ids,
-                sums,
-                lattice.as_ref(),
-                |block, window| {
-                    let mut scratch = Stencil::new();
-                    for &i in block {
-                        let i = i as usize;
-                        let (m, v, x) = (p.mass[i], p.velocity[i], p.position[i]);
-                        let volume = p.volume[i];
-                        let stress_volume = stresses[i] * volume;
-                        let acceleration =
-                            gravity + body.get(i).copied().unwrap_or_else(SVector::zeros);
-                        let mut sink = ScatterEntry::<D, T, CORRECTED, A> {
-                            window,
-                            load: ParticleLoad {
-                                mass: m,
-                                velocity: v,
-                                affine: SMatrix::zeros(),
-                                volume,
-                                stress_volume,
-                                acceleration,
-                            },
-                            correction: correction.unwrap_or(&[]),
-                            correction_mean: SVector::zeros(),
-                            transfer: std::marker::PhantomData::<T>,
-                        };
-                        let stored_moment = stencils.stored_second_moment(i);
-                        // The limiter and the correction's ξ̄_p read the whole stencil before
-                        // the first entry, unless the stencil stage stored what they need.
-                        let limiter_reads = T::AFFINE && varying_moment && stored_moment.is_none();
-                        let stored_mean = correction.and(stencils.stored_correction_mean(i));
-                        let mean_reads = correction.is_some() && stored_mean.is_none();
-                        if let Some(mean) = stored_mean {
-                            sink.correction_mean = *mean;
-                        }
-                        if T::FUSED_FORCE {
-                            // MLS-MPM: ∇N_i ≈ D⁻¹ N_i r_i folds the stress impulse into the
-                            // affine term, and gravity into the momentum.
-                            let inverse_moment = 1.0 / constant_moment;
-                            sink.load.affine =
-                                p.affine[i] * m - stress_volume * (dt * inverse_moment);
-                            sink.load.velocity = (v + acceleration * dt) * m;
-                        } else if let Some(d) = stored_moment.filter(|_| T::AFFINE) {
-                            // D_p summed with the stencil ([`Stencils::compute`]): the entries
-                            // are visited once.
-                            sink.load.affine =
-                                limited_affine(&p.affine[i], p.affine_moment[i], || *d);
-                        } else if T::AFFINE && !limiter_reads {
-                            sink.load.affine = p.affine[i];
-                        }
-                        if let Some(width) = tensor_width {
-                            let (window, load) = (&mut *sink.window, &sink.load);
-                            match width {
-                                3 => {
-                                    let t = kernel.tensor_stencil::<3>(&x).map_err(|e| (i, e))?;
-                                    scatter_rows::<D, 3, T>(&t, window, load);
-                                }
-                                _ => {
-                                    let t = kernel.tensor_stencil::<4>(&x).map_err(|e| (i, e))?;
-                                    scatter_rows::<D, 4, T>(&t, window, load);
-                                }
-                            }
-                        } else if limiter_reads || mean_reads {
-                            // One evaluation serves the whole-stencil sums and the entries.
-                            stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
-                                if let Some(xi) = correction.filter(|_| mean_reads) {
-                                    sink.correction_mean = correction_mean(&st, xi);
-                                }
-                                if limiter_reads {
-                                    sink.load.affine =
-                                        limited_affine(&p.affine[i], p.affine_moment[i], || {
-                                            second_moment(&st, kernel, &x)
-                                        });
-                                }
-                                for e in 0..st.len() {
-                                    let r = st.offset(e, kernel, &x);
-                                    sink.entry(st.nodes[e], st.values[e], &st.gradients[e], &r);
-                                }
-                            })?;
-                        } else {
-                            stencils.visit(
-                                i,
-                                kernel,
-                                &x,
-                                &p.cache[i],
-                                &mut scratch,
-                                T::AFFINE,
-                                &mut sink,
-                            )?;
-                        }
+            .scatter(ranges, ids, sums, lattice.as_ref(), |block, window| {
+                let mut scratch = Stencil::new();
+                for &i in block {
+                    let i = i as usize;
+                    let (m, v, x) = (p.mass[i], p.velocity[i], p.position[i]);
+                    let volume = p.volume[i];
+                    let stress_volume = stresses[i] * volume;
+                    let acceleration =
+                        gravity + body.get(i).copied().unwrap_or_else(SVector::zeros);
+                    let mut sink = ScatterEntry::<D, T, CORRECTED, A> {
+                        window,
+                        load: ParticleLoad {
+                            mass: m,
+                            velocity: v,
+                            affine: SMatrix::zeros(),
+                            volume,
+                            stress_volume,
+                            acceleration,
+                        },
+                        correction: correction.unwrap_or(&[]),
+                        correction_mean: SVector::zeros(),
+                        transfer: std::marker::PhantomData::<T>,
+                    };
+                    let stored_moment = stencils.stored_second_moment(i);
+                    // The limiter and the correction's ξ̄_p read the whole stencil before
+                    // the first entry, unless the stencil stage stored what they need.
+                    let limiter_reads = T::AFFINE && varying_moment && stored_moment.is_none();
+                    let stored_mean = correction.and(stencils.stored_correction_mean(i));
+                    let mean_reads = correction.is_some() && stored_mean.is_none();
+                    if let Some(mean) = stored_mean {
+                        sink.correction_mean = *mean;
                     }
-                    Ok(())
-                },
-            )
+                    if T::FUSED_FORCE {
+                        // MLS-MPM: ∇N_i ≈ D⁻¹ N_i r_i folds the stress impulse into the
+                        // affine term, and gravity into the momentum.
+                        let inverse_moment = 1.0 / constant_moment;
+                        sink.load.affine = p.affine[i] * m - stress_volume * (dt * inverse_moment);
+                        sink.load.velocity = (v + acceleration * dt) * m;
+                    } else if let Some(d) = stored_moment.filter(|_| T::AFFINE) {
+                        // D_p summed with the stencil ([`Stencils::compute`]): the entries
+                        // are visited once.
+                        sink.load.affine = limited_affine(&p.affine[i], p.affine_moment[i], || *d);
+                    } else if T::AFFINE && !limiter_reads {
+                        sink.load.affine = p.affine[i];
+                    }
+                    if let Some(width) = tensor_width {
+                        let (window, load) = (&mut *sink.window, &sink.load);
+                        match width {
+                            3 => {
+                                let t = kernel.tensor_stencil::<3>(&x).map_err(|e| (i, e))?;
+                                scatter_rows::<D, 3, T>(&t, window, load);
+                            }
+                            _ => {
+                                let t = kernel.tensor_stencil::<4>(&x).map_err(|e| (i, e))?;
+                                scatter_rows::<D, 4, T>(&t, window, load);
+                            }
+                        }
+                    } else if limiter_reads || mean_reads {
+                        // One evaluation serves the whole-stencil sums and the entries.
+                        stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
+                            if let Some(xi) = correction.filter(|_| mean_reads) {
+                                sink.correction_mean = correction_mean(&st, xi);
+                            }
+                            if limiter_reads {
+                                sink.load.affine =
+                                    limited_affine(&p.affine[i], p.affine_moment[i], || {
+                                        second_moment(&st, kernel, &x)
+                                    });
+                            }
+                            for e in 0..st.len() {
+                                let r = st.offset(e, kernel, &x);
+                                sink.entry(st.nodes[e], st.values[e], &st.gradients[e], &r);
+                            }
+                        })?;
+                    } else {
+                        stencils.visit(
+                            i,
+                            kernel,
+                            &x,
+                            &p.cache[i],
+                            &mut scratch,
+                            T::AFFINE,
+                            &mut sink,
+                        )?;
+                    }
+                }
+                Ok(())
+            })
             .map_err(|(particle, source)| EngineError::Kernel {
                 step,
                 particle,
