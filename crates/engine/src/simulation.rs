@@ -644,13 +644,18 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         }
         self.times.grid_update += clock.lap();
         // 4. G2P and walls.
-        self.grid_to_particles(dt)?;
-        if self.settings.stress_update == StressUpdate::Musl {
-            self.musl_velocity_gradients()?;
-        }
+        let updated = self.grid_to_particles(dt);
         self.times.grid_to_particles += clock.lap();
-        // 5. Deformation and stress update.
-        let min_density = self.update_deformation(dt)?;
+        // 5. Deformation and stress update: under USL G2P made it (its time is
+        // G2P's); MUSL re-maps the velocities first.
+        let min_density = match updated? {
+            Some(min_density) => min_density,
+            None => {
+                self.musl_velocity_gradients()?;
+                self.times.grid_to_particles += clock.lap();
+                self.update_deformation(dt)?
+            }
+        };
         self.times.constitutive += clock.lap();
         self.step += 1;
         self.time += dt;

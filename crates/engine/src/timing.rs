@@ -8,13 +8,15 @@ use std::time::Instant;
 pub struct StageTimes {
     /// Locating particles and evaluating shape functions.
     pub stencils: f64,
-    /// Kirchhoff stresses for P2G, and the deformation update with return mapping.
+    /// Kirchhoff stresses for P2G, and the deformation update with return mapping
+    /// where it is a stage of its own (MUSL; under USL G2P makes it, in its time).
     pub constitutive: f64,
     /// The particle-to-grid scatter and its reduction.
     pub particles_to_grid: f64,
     /// Nodal velocities, boundary conditions, damping, mass scaling.
     pub grid_update: f64,
-    /// Grid-to-particle gather, MUSL re-map and walls.
+    /// Grid-to-particle gather, MUSL re-map and walls, and under USL the deformation
+    /// update.
     pub grid_to_particles: f64,
     /// Non-finite, inversion and energy checks.
     pub checks: f64,

@@ -5,10 +5,13 @@
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use nalgebra::{Matrix2, SVector, Vector2};
+use nalgebra::{Matrix2, Vector2};
 use umls_constitutive::{Constitutive, ConstitutiveError, ElasticParameters, NeoHookean};
-use umls_engine::{Apic, Particles, Simulation, StepSettings};
-use umls_kernels::{BSplineKernel, BSplineOrder};
+use umls_engine::{Apic, Simulation, StepSettings};
+use umls_kernels::BSplineKernel;
+
+#[path = "common/moving_square.rs"]
+mod moving_square;
 
 /// Neo-Hookean, counting how often each stress entry point is called.
 #[derive(Debug)]
@@ -68,21 +71,11 @@ impl Constitutive<2> for Counting {
 
 /// A spinning, stretched square of particles on a quadratic B-spline grid.
 fn simulation(young: f64) -> Simulation<2, BSplineKernel<2>, Counting, Apic> {
-    let grid = BSplineKernel::new(
-        Vector2::new(-0.2, -0.2),
-        0.1,
-        [14, 14],
-        BSplineOrder::Quadratic,
-    )
-    .unwrap();
-    let (x, volume): (Vec<Vector2<f64>>, Vec<f64>) =
-        umls_engine::lattice_points(Vector2::new(0.3, 0.3), Vector2::new(0.7, 0.7), 0.025).unzip();
-    let mut particles = Particles::at_rest(x, volume, 1000.0, ());
-    for (v, x) in particles.velocity.iter_mut().zip(&particles.position) {
-        *v = SVector::from([-(x[1] - 0.5) + 0.3 * (x[0] - 0.5), x[0] - 0.5]);
-    }
+    let particles = moving_square::particles(0.025, (), |x| {
+        Vector2::new(-(x[1] - 0.5) + 0.3 * (x[0] - 0.5), x[0] - 0.5)
+    });
     Simulation::new(
-        grid,
+        moving_square::grid(),
         Counting::new(young),
         Apic,
         particles,

@@ -1,5 +1,6 @@
 //! Stage 5 of the step and the start of the next: F ← (I + Δt ∇v) F with the material's
-//! return map, and the Kirchhoff stresses P2G spreads.
+//! return map, and the Kirchhoff stresses P2G spreads. Under USL G2P calls the
+//! per-particle update ([`update_one`]) itself, right after each particle's gather.
 
 use nalgebra::SMatrix;
 use rayon::prelude::*;
@@ -50,7 +51,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     /// next step's P2G, in one call of the material (`return_map_and_stress`: one
     /// decomposition for plastic models); the smallest density m / (V⁰ det F). Each
     /// particle's velocity gradient is read from its slot of the stress buffer (where
-    /// G2P left it) and replaced there by its stress.
+    /// MUSL's re-map left it) and replaced there by its stress. Under USL G2P makes the
+    /// same update per particle instead.
     pub(super) fn update_deformation(&mut self, dt: f64) -> Result<f64, EngineError> {
         let step = self.step;
         let material = &self.material;
@@ -100,10 +102,11 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     }
 }
 
-/// One particle's F ← (I + Δt ∇v) F, return map and stress; det F on success.
+/// One particle's F ← (I + Δt ∇v) F, return map and stress; det F on success. G2P
+/// calls it under USL ([`Simulation::grid_to_particles`]), the stage below under MUSL.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn update_one<const D: usize, M: Constitutive<D>>(
+pub(super) fn update_one<const D: usize, M: Constitutive<D>>(
     material: &M,
     f: &mut SMatrix<f64, D, D>,
     state: &mut M::State,

@@ -7,12 +7,13 @@ use umls_constitutive::Constitutive;
 use umls_transfer::{Kernel, KernelError, Stencil};
 
 use super::Simulation;
+use super::constitutive::update_one;
 use super::tensor_rows::{gather_rows, row_width};
 use crate::boundary::Boundary;
 use crate::error::EngineError;
 use crate::parallel::lowest_failure;
 use crate::stencils::{EntrySink, Stencils};
-use crate::transfer::TransferScheme;
+use crate::transfer::{StressUpdate, TransferScheme};
 
 /// What G2P computes for one particle.
 #[derive(Debug, Clone, Copy)]
@@ -165,7 +166,7 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
 }
 
 /// One chunk's share of the G2P totals.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug)]
 struct ChunkTotals {
     /// Work of the body loads.
     power: f64,
@@ -177,24 +178,37 @@ struct ChunkTotals {
     fastest: (usize, f64),
     /// The first particle left with a non-finite velocity or position.
     non_finite: Option<usize>,
+    /// The smallest density m / (V⁰ det F) after the deformation update, where G2P
+    /// made it (infinite otherwise).
+    min_density: f64,
+    /// The deformation update's first failure (particle, error), where G2P made it.
+    deformation_failure: Option<(usize, EngineError)>,
 }
 
 impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
-    /// G2P and the walls. The velocity gradients go to the stress buffer: P2G has read
-    /// this step's stresses, and the deformation update turns each gradient into the
-    /// next stress in place, so no buffer of their own is needed (MUSL's re-map
-    /// overwrites them there).
-    pub(super) fn grid_to_particles(&mut self, dt: f64) -> Result<(), EngineError> {
+    /// G2P and the walls, and under USL each particle's deformation update (stage 5)
+    /// right after its G2P, while the particle is in cache: that returns the smallest
+    /// density the update found. Under MUSL the velocity gradients go to the stress
+    /// buffer instead (P2G has read this step's stresses), where the re-map overwrites
+    /// them and [`Self::update_deformation`] turns each into the next stress in place,
+    /// and this returns `None`.
+    ///
+    /// A kernel error anywhere comes first (the lowest particle's), then a deformation
+    /// update's (the lowest particle's, after the G2P totals are recorded): the order
+    /// the stages report in when they run one after the other.
+    pub(super) fn grid_to_particles(&mut self, dt: f64) -> Result<Option<f64>, EngineError> {
         self.stresses_current = false;
-        let mut velocity_gradients = std::mem::take(&mut self.stress_buffer);
-        velocity_gradients.resize(self.particles.len(), SMatrix::zeros());
+        let deform = self.settings.stress_update == StressUpdate::Usl;
+        let material = &self.material;
+        let mut stress_slots = std::mem::take(&mut self.stress_buffer);
+        stress_slots.resize(self.particles.len(), SMatrix::zeros());
         let (kernel, transfer, stencils) = (&self.kernel, self.transfer, &self.stencils);
         let grid = GridVelocities {
             old: &self.grid.velocity,
             new: &self.grid.new_velocity,
         };
         let p = &mut self.particles;
-        let mass = &p.mass;
+        let (mass, volume) = (&p.mass, &p.volume);
         let (gravity, step) = (self.settings.gravity_at(self.time), self.step);
         let body = &self.body_accelerations;
         let boundary = &self.boundary;
@@ -213,18 +227,22 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .zip(p.position.par_chunks_mut(chunk))
             .zip(p.affine.par_chunks_mut(chunk))
             .zip(p.affine_moment.par_chunks_mut(chunk))
-            .zip(velocity_gradients.par_chunks_mut(chunk))
+            .zip(stress_slots.par_chunks_mut(chunk))
             .zip(p.cache.par_chunks_mut(chunk))
+            .zip(p.deformation.par_chunks_mut(chunk))
+            .zip(p.state.par_chunks_mut(chunk))
             .enumerate()
             .map(
-                |(c, (((((velocity, position), affine), moment), gradient), cache))| {
+                |(c, (((((((velocity, position), affine), moment), slot), cache), fs), states))| {
                     // The chunk's slices at one length, so the loop below indexes them
                     // without a bounds check per particle and array.
                     let n = velocity.len();
                     let (position, affine, moment) =
                         (&mut position[..n], &mut affine[..n], &mut moment[..n]);
-                    let (gradient, cache) = (&mut gradient[..n], &mut cache[..n]);
+                    let (slot, cache) = (&mut slot[..n], &mut cache[..n]);
+                    let (fs, states) = (&mut fs[..n], &mut states[..n]);
                     let mass = &mass[c * chunk..c * chunk + n];
+                    let volume = &volume[c * chunk..c * chunk + n];
                     let mut scratch = Stencil::new();
                     // Work of gravity and body forces with the mean of old and new velocity:
                     // the trapezoidal rule balances the kinetic energy of a free fall exactly.
@@ -239,6 +257,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     // in cache instead of in a serial pass after the step.
                     let mut fastest = (0, 0.0f64);
                     let mut non_finite = None;
+                    let mut min_density = f64::INFINITY;
+                    // A failing update does not stop the chunk, as in
+                    // [`Simulation::update_deformation`].
+                    let mut deformation_failure = None;
                     for k in 0..n {
                         let i = c * chunk + k;
                         let x = position[k];
@@ -264,7 +286,29 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         position[k] = u.position;
                         affine[k] = u.affine;
                         moment[k] = u.affine_moment;
-                        gradient[k] = u.velocity_gradient;
+                        if deform {
+                            // The particle's stress slot takes its next stress (under
+                            // MUSL its velocity gradient, which the re-map replaces).
+                            match update_one(
+                                material,
+                                &mut fs[k],
+                                &mut states[k],
+                                &u.velocity_gradient,
+                                &mut slot[k],
+                                dt,
+                                step,
+                                i,
+                            ) {
+                                Ok(det) => {
+                                    min_density = min_density.min(mass[k] / (volume[k] * det));
+                                }
+                                Err(e) => {
+                                    deformation_failure.get_or_insert((i, e));
+                                }
+                            }
+                        } else {
+                            slot[k] = u.velocity_gradient;
+                        }
                         if boundary.hold(&mut position[k], &mut velocity[k]) {
                             corrections += 1;
                         }
@@ -299,6 +343,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         corrections,
                         fastest,
                         non_finite,
+                        min_density,
+                        deformation_failure,
                     }])
                 },
             )
@@ -311,7 +357,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     })
                 },
             );
-        self.stress_buffer = velocity_gradients;
+        self.stress_buffer = stress_slots;
         let partials = partials.map_err(|(particle, source)| EngineError::Kernel {
             step,
             particle,
@@ -321,6 +367,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let mut longest = (0, 0.0f64);
         let mut fastest = (0, 0.0f64);
         let mut non_finite = None;
+        let mut min_density = f64::INFINITY;
+        let mut deformation_failure = None;
         for chunk in partials {
             power += chunk.power;
             if chunk.longest.1 > longest.1 {
@@ -331,11 +379,22 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             }
             non_finite = non_finite.or(chunk.non_finite);
             self.totals.wall_corrections += chunk.corrections;
+            min_density = min_density.min(chunk.min_density);
+            // The chunks come in particle order: the first failure is the lowest.
+            deformation_failure = deformation_failure.or(chunk.deformation_failure);
         }
         self.totals.external_work += power * dt;
         self.totals.longest_move = (longest.0, longest.1.sqrt());
         self.totals.fastest = fastest;
         self.totals.first_non_finite = non_finite;
-        Ok(())
+        if !deform {
+            return Ok(None);
+        }
+        // Whole only if every particle got its stress.
+        self.stresses_current = deformation_failure.is_none();
+        match deformation_failure {
+            Some((_, e)) => Err(e),
+            None => Ok(Some(min_density)),
+        }
     }
 }
