@@ -7,8 +7,9 @@
 //! force (−Σ V⁰ τ ∇N + gravity and body forces), grid update (empty and mass-scaled nodes,
 //! damping, boundary conditions: node sets, walls, clamps imposed on the fit
 //! ([`FittedClamp`])), G2P of velocity, affine matrix and position, walls that
-//! hold the particles, then F ← (I + Δt∇v)F and the material's return map (USL, or MUSL
-//! with re-mapped momenta). The time step is fixed or adaptive
+//! hold the particles, then F ← (I + Δt∇v)F and the material's return map (USL: inside
+//! G2P, each particle right after its gather; or MUSL with re-mapped momenta, as a stage
+//! of its own). The time step is fixed or adaptive
 //! ([`Simulation::stable_time_step`]: one definition for every kernel). Failures stop the
 //! run with a typed [`EngineError`] naming the step and particle or node: kernel errors,
 //! NaN, det F ≤ 0, a Δt above the stable step, a particle moving more than a spacing per
