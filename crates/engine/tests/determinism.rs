@@ -6,33 +6,16 @@
 use std::sync::Arc;
 
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
-use umls_constitutive::{ElasticParameters, NeoHookean};
 use umls_engine::{
-    Apic, ApicFlip, Flip, MlsMpm, Particles, Pic, Region, Simulation, StencilStorage, StepSettings,
-    TransferScheme, VelocityGradientAffine, lattice_samples,
+    Apic, ApicFlip, Flip, MlsMpm, Pic, StencilStorage, StepSettings, TransferScheme,
+    VelocityGradientAffine,
 };
 use umls_kernels::{BSplineKernel, BSplineOrder, Umls2, Umls3};
 use umls_mesh::generate::{Diagonal, Lattice};
 use umls_transfer::Kernel;
 
-/// Particles on a lattice of spacing `h` spinning and falling inside the unit box.
-fn particles<const D: usize, C: Copy + Default>(h: f64) -> Particles<D, (), C> {
-    let lower = SVector::<f64, D>::from_element(0.3);
-    let upper = SVector::<f64, D>::from_element(0.7);
-    let region = Region::Box { lower, upper };
-    Particles::seed(
-        &lattice_samples(lower, upper, h),
-        &region,
-        1000.0,
-        (),
-        |x| {
-            let mut v = SVector::<f64, D>::zeros();
-            v[0] = -(x[1] - 0.5);
-            v[1] = x[0] - 0.5;
-            v
-        },
-    )
-}
+#[path = "common/spinning_block.rs"]
+mod spinning_block;
 
 /// Positions, velocities and deformation gradients.
 type State<const D: usize> = (
@@ -67,23 +50,9 @@ fn state_with<const D: usize, K: Kernel<D> + Clone + Send + Sync, T: TransferSch
         .build()
         .unwrap();
     pool.install(|| {
-        let material = NeoHookean {
-            parameters: ElasticParameters::from_young_poisson(1e4, 0.3).unwrap(),
-        };
         let mut settings = StepSettings::new(1.0);
         settings.stencil_storage = storage;
-        let mut gravity = SVector::<f64, D>::zeros();
-        gravity[D - 1] = -9.81;
-        settings.gravity = gravity;
-        let mut sim = Simulation::new(
-            kernel.clone(),
-            material,
-            transfer,
-            particles::<D, K::Cache>(h),
-            settings,
-        )
-        .unwrap();
-        sim.settings.dt = sim.stable_time_step(0.3);
+        let mut sim = spinning_block::simulation(kernel.clone(), transfer, (h, 1.0), settings);
         for _ in 0..steps {
             sim.step().unwrap();
         }
@@ -187,7 +156,7 @@ fn a_scrambled_numbering_changes_only_the_summation_order() {
     let scrambled =
         umls_mesh::SimplexMesh::new(vertices, simplices, umls_mesh::Orientation::Fix).unwrap();
     let h = 0.002;
-    assert!(particles::<2, ()>(h).len() > 8 * PARALLEL_SCATTER);
+    assert!(spinning_block::particles::<2, ()>(h, 1.0).len() > 8 * PARALLEL_SCATTER);
     assert_thread_independent(
         "umls, scrambled",
         Umls2::new(Arc::new(scrambled.clone())),

@@ -6,34 +6,17 @@
 use std::sync::Arc;
 
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
-use umls_constitutive::{ElasticParameters, NeoHookean};
+use umls_constitutive::NeoHookean;
 use umls_engine::{
-    Apic, EngineError, FittedClamp, Flip, MlsMpm, Particles, Region, Simulation, StepSettings,
-    TransferScheme, lattice_samples,
+    Apic, EngineError, FittedClamp, Flip, MlsMpm, Simulation, StepSettings, TransferScheme,
 };
 use umls_kernels::{BSplineKernel, BSplineOrder, Umls2};
 use umls_mesh::SimplexMesh;
 use umls_mesh::generate::{Diagonal, Lattice};
 use umls_transfer::Kernel;
 
-/// Particles on a lattice of spacing `h` in [0.3, 0.7]^D, spinning about the box's centre
-/// line, so that they cross cells and their P2G order drifts from the lattice's.
-fn particles<const D: usize, C: Copy + Default>(h: f64) -> Particles<D, (), C> {
-    let lower = SVector::<f64, D>::from_element(0.3);
-    let upper = SVector::<f64, D>::from_element(0.7);
-    Particles::seed(
-        &lattice_samples(lower, upper, h),
-        &Region::Box { lower, upper },
-        1000.0,
-        (),
-        |x| {
-            let mut v = SVector::<f64, D>::zeros();
-            v[0] = -3.0 * (x[1] - 0.5);
-            v[1] = 3.0 * (x[0] - 0.5);
-            v
-        },
-    )
-}
+#[path = "common/spinning_block.rs"]
+mod spinning_block;
 
 /// Per particle (by its index at construction): position, velocity, affine matrix,
 /// deformation gradient.
@@ -44,29 +27,19 @@ type State<const D: usize> = Vec<(
     SMatrix<f64, D, D>,
 )>;
 
-/// A simulation of [`particles`] under gravity, with a body force that depends on the
-/// particle's index (so a force that followed the slot instead would change the result).
+/// The spinning block (three radians per second, so that its particles cross cells and
+/// their P2G order drifts from the lattice's) under gravity, with a body force that
+/// depends on the particle's index (so a force that followed the slot instead would
+/// change the result).
 fn simulation<const D: usize, K: Kernel<D>, T: TransferScheme>(
     kernel: K,
     transfer: T,
     h: f64,
     sort_interval: usize,
 ) -> Simulation<D, K, NeoHookean, T> {
-    let material = NeoHookean {
-        parameters: ElasticParameters::from_young_poisson(1e4, 0.3).unwrap(),
-    };
     let mut settings = StepSettings::new(1.0);
-    settings.gravity[D - 1] = -9.81;
     settings.particle_sort_interval = sort_interval;
-    let mut sim = Simulation::new(
-        kernel,
-        material,
-        transfer,
-        particles::<D, K::Cache>(h),
-        settings,
-    )
-    .unwrap();
-    sim.settings.dt = sim.stable_time_step(0.3);
+    let mut sim = spinning_block::simulation(kernel, transfer, (h, 3.0), settings);
     sim.body_force = Some(Arc::new(|p: usize, _: &SVector<f64, D>, _: f64| {
         let mut b = SVector::<f64, D>::zeros();
         b[0] = (p % 7) as f64 - 3.0;
