@@ -60,15 +60,21 @@ pub(crate) struct Grid<const D: usize> {
     pub force: Vec<SVector<f64, D>>,
     /// Σ V_p |∇N_ip|² (times the p-wave modulus: the node's diagonal stiffness).
     pub stiffness: Vec<f64>,
-    /// v_i = p_i / m_i.
+    /// v_i = p_i / m_i, written by the update only where [`Self::keep_velocity`] asks
+    /// for it (else stale: no reader looks).
     pub velocity: Vec<SVector<f64, D>>,
+    /// Whether the update writes `velocity` (and applies the walls to it): for FLIP,
+    /// whose G2P reads it. Without a reader the write was a third of the update's
+    /// stores; local damping and the MUSL re-map compute it anew where they need it.
+    pub keep_velocity: bool,
     /// ṽ_i = v_i + Δt f_i / m_i (Δt f_i / Δt² k_i on mass-scaled nodes), plus the
     /// redistributed impulse, with boundary conditions.
     pub new_velocity: Vec<SVector<f64, D>>,
     /// Per segment of [`crate::scatter::LIVE_SEGMENT`] nodes: whether it may hold
-    /// non-zero values this step. The others hold zeros in every field (every writer
-    /// leaves a node without mass at zero), so P2G's merge and the grid update skip them:
-    /// a body in a large box of empty nodes does not pay for the box.
+    /// non-zero values this step. The others hold zeros in every field but an unkept
+    /// `velocity` (every writer leaves a node without mass at zero), so P2G's merge and
+    /// the grid update skip them: a body in a large box of empty nodes does not pay for
+    /// the box.
     pub live: Vec<bool>,
     /// Contributions below this mass are round-off (10⁻¹² of the heaviest particle).
     pub round_off_mass: f64,
@@ -168,6 +174,7 @@ impl<const D: usize> Grid<D> {
             abs_mass: vec![0.0; nodes],
             abs_mass_is_mass: false,
             momentum_only: false,
+            keep_velocity: true,
             momentum: vec![SVector::zeros(); nodes],
             force: vec![SVector::zeros(); nodes],
             stiffness: vec![0.0; nodes],
@@ -250,6 +257,7 @@ impl<const D: usize> Grid<D> {
         // chunk order, so the report does not depend on the thread count.
         let round_off = self.round_off_mass;
         let momentum_only = self.momentum_only;
+        let keep_velocity = self.keep_velocity;
         let local_damping = matches!(damping, Damping::Local { .. });
         // Not through `Self::abs_mass`, which would borrow the whole grid.
         let abs_mass = abs_mass_of(&self.mass, &self.abs_mass, self.abs_mass_is_mass);
@@ -286,7 +294,9 @@ impl<const D: usize> Grid<D> {
                             // ∇N ≠ 0).
                             dropped += m;
                             redistributed += momentum[i] + force_i * dt;
-                            velocity[i] = SVector::zeros();
+                            if keep_velocity {
+                                velocity[i] = SVector::zeros();
+                            }
                             new_velocity[i] = SVector::zeros();
                             continue;
                         }
@@ -298,7 +308,9 @@ impl<const D: usize> Grid<D> {
                             damped(force_i, v, m, damping)
                         };
                         let scaled_mass = dt * dt * modulus * stiffness_i;
-                        velocity[i] = v;
+                        if keep_velocity {
+                            velocity[i] = v;
+                        }
                         if scaled_mass > m.abs() {
                             // Selective mass scaling: the node moves as if it had mass
                             // Δt² k, and the impulse it cannot absorb goes to the active
@@ -337,7 +349,9 @@ impl<const D: usize> Grid<D> {
                     }
                 });
         }
-        boundary.apply_live(&mut self.velocity, &self.live);
+        if keep_velocity {
+            boundary.apply_live(&mut self.velocity, &self.live);
+        }
         boundary.apply_live(&mut self.new_velocity, &self.live);
         if let Some(r) = reactions {
             r.0.reactions(boundary, &self.mass, &self.new_velocity, dt, &mut r.1);

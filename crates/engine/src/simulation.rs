@@ -612,6 +612,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 .record(&self.boundary, &self.grid.momentum, &self.grid.force, dt);
         }
         self.boundary.sort_by_node();
+        // Only FLIP's G2P reads the velocities before the update.
+        self.grid.keep_velocity = T::USES_FLIP;
         let report = self.grid.update(
             dt,
             self.material.p_wave_modulus(),
