@@ -750,7 +750,11 @@ fn transfer_name(spec: &crate::schema::TransferSpec) -> String {
         Some(m) => format!(
             "{name}, consistent mass ({} iterations{})",
             m.iterations,
-            if m.forces { ", forces too" } else { "" }
+            match m.forces.share() {
+                0.0 => String::new(),
+                1.0 => ", forces too".into(),
+                beta => format!(", forces with share {beta}"),
+            }
         ),
     }
 }

@@ -440,18 +440,46 @@ pub struct TransferSpec {
 pub struct MassSpec {
     /// Jacobi iterations (1 or more).
     pub iterations: usize,
-    /// Whether the forces are solved with it too (default false: the velocity only).
+    /// The forces' share of it (default false: the velocity only).
     #[serde(default)]
-    pub forces: bool,
+    pub forces: ForceShare,
+}
+
+/// `transfer.mass.forces`: `true` solves the forces with the consistent matrix too,
+/// `false` leaves them lumped, a number β ∈ [0, 1] uses (1 − β) M_L + β M_C (½: the mixed
+/// matrix).
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(untagged)]
+pub enum ForceShare {
+    /// All (1) or nothing (0).
+    Whole(bool),
+    /// The consistent matrix's share β.
+    Share(f64),
+}
+
+impl Default for ForceShare {
+    fn default() -> Self {
+        Self::Whole(false)
+    }
+}
+
+impl ForceShare {
+    /// β.
+    pub fn share(self) -> f64 {
+        match self {
+            Self::Whole(whole) => f64::from(u8::from(whole)),
+            Self::Share(beta) => beta,
+        }
+    }
 }
 
 impl MassSpec {
-    /// The engine's setting.
+    /// The engine's setting (β outside [0, 1] is refused by the engine, by name).
     pub fn matrix(spec: Option<Self>) -> umls_engine::MassMatrix {
         spec.map_or(umls_engine::MassMatrix::Lumped, |m| {
             umls_engine::MassMatrix::Consistent {
                 iterations: m.iterations,
-                forces: m.forces,
+                forces: m.forces.share(),
             }
         })
     }

@@ -102,6 +102,50 @@ fn consistent_mass_keeps_the_disks_energy_under_apic() {
     assert!(refused.contains("consistent mass"), "{refused}");
 }
 
+/// `forces = 0.5` in `[transfer] mass`: the forces' mass matrix halfway between lumped
+/// and consistent (the mixed matrix). The scene file takes the share, the summary names
+/// it, the run differs from both ends' runs, and a share outside [0, 1] is refused by
+/// the parameter's name.
+#[test]
+fn a_forces_share_between_lumped_and_consistent_is_read_and_checked() {
+    let bar = |forces: &str| {
+        let scene = variant(
+            "vibrating-bar",
+            &[(
+                "kind = \"apic\"",
+                &format!("kind = \"apic\"\nmass = {{ iterations = 2, forces = {forces} }}"),
+            )],
+        );
+        let name = format!("bar-forces-{}", forces.replace('.', "_"));
+        run(
+            &scene,
+            &options(&name, Some(KernelKind::Bspline2), Some(1.0)),
+        )
+    };
+    let rmse = |forces: &str| -> (f64, String) {
+        let report = bar(forces).unwrap();
+        (
+            metric(&report.summary, "velocity_rmse"),
+            report.summary["transfer"].as_str().unwrap().to_owned(),
+        )
+    };
+    let (lumped, name) = rmse("false");
+    assert_eq!(name, "apic, consistent mass (2 iterations)");
+    let (whole, name) = rmse("true");
+    assert_eq!(name, "apic, consistent mass (2 iterations, forces too)");
+    let (mixed, name) = rmse("0.5");
+    assert_eq!(
+        name,
+        "apic, consistent mass (2 iterations, forces with share 0.5)"
+    );
+    assert!(
+        mixed != lumped && mixed != whole,
+        "lumped forces {lumped}, consistent {whole}, mixed {mixed}"
+    );
+    let refused = bar("1.5").unwrap_err().to_string();
+    assert!(refused.contains("mass_matrix.forces"), "{refused}");
+}
+
 /// Sharpened distance weights (`umls-sharp`: the cubic B-spline divided by 1 + (r/ε)²,
 /// ε = 0.4) bring the UMLS round trip closer to interpolating its nearest vertices, so it
 /// filters less: with APIC the disks lose what bspline2 loses (measured by t = 3: 0.697

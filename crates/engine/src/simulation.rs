@@ -200,12 +200,18 @@ impl<const D: usize> StepSettings<D> {
                 reason: "must be finite",
             });
         }
-        if let crate::settings::MassMatrix::Consistent { iterations, .. } = self.mass_matrix {
+        if let crate::settings::MassMatrix::Consistent { iterations, forces } = self.mass_matrix {
             check(
                 "mass_matrix.iterations",
                 iterations as f64,
                 iterations >= 1,
                 "must be at least 1",
+            )?;
+            check(
+                "mass_matrix.forces",
+                forces,
+                (0.0..=1.0).contains(&forces),
+                "must lie in [0, 1]",
             )?;
         }
         if let TimeStepControl::Adaptive { cfl } = self.time_step {
@@ -374,19 +380,21 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     }
 
     /// The explicit step bound cfl · h / (c + |v|_max) from a speed and a density,
-    /// divided by √k when k mass iterations act on the forces (they raise the highest
-    /// frequency by up to √k).
+    /// divided by the mass matrix's [`crate::MassMatrix::force_step_factor`] when mass
+    /// iterations act on the forces (they raise the highest frequency).
     fn stable_step_from(&self, cfl: f64, max_speed: f64, min_density: f64) -> f64 {
         let c = self.material.p_wave_speed(min_density);
-        let iterations = self.settings.mass_matrix.force_iterations().max(1);
-        cfl * self.kernel.spacing() / (c + max_speed) / (iterations as f64).sqrt()
+        cfl * self.kernel.spacing()
+            / (c + max_speed)
+            / self.settings.mass_matrix.force_step_factor()
     }
 
     /// The stable time step for Courant number `cfl`: cfl · h / (c + |v|_max), with h the
     /// kernel's effective spacing ([`Kernel::spacing`]), c the p-wave speed at the
     /// smallest current particle density and |v|_max the fastest particle. The same
     /// definition for every kernel; `cfl` = 1 is the stability limit. With k mass
-    /// iterations on the forces ([`crate::MassMatrix::Consistent`]) it is divided by √k.
+    /// iterations on the forces ([`crate::MassMatrix::Consistent`]) it is divided by
+    /// [`crate::MassMatrix::force_step_factor`] (√k for the consistent matrix).
     pub fn stable_time_step(&self, cfl: f64) -> f64 {
         let (speed, density) = self.speed_and_density();
         self.stable_step_from(cfl, speed, density)
@@ -472,8 +480,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             mass: p.mass.iter().sum(),
             max_speed,
             courant: max_speed * dt / h,
-            wave_courant: (c + max_speed) * dt / h
-                * (self.settings.mass_matrix.force_iterations().max(1) as f64).sqrt(),
+            wave_courant: (c + max_speed) * dt / h * self.settings.mass_matrix.force_step_factor(),
             dropped_mass: self.totals.dropped_mass,
             redistributed_momentum: self.totals.redistributed_momentum,
             wall_corrections: self.totals.wall_corrections,

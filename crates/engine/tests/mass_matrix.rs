@@ -47,7 +47,7 @@ fn grid() -> BSplineKernel<2> {
     unit_square::grid(BSplineOrder::Quadratic)
 }
 
-fn consistent(iterations: usize, forces: bool) -> MassMatrix {
+fn consistent(iterations: usize, forces: f64) -> MassMatrix {
     MassMatrix::Consistent { iterations, forces }
 }
 
@@ -62,7 +62,7 @@ fn affine_fields_are_fixed_points_of_the_iterations() {
         let mut particles = block(|x| a + c * x);
         particles.affine.iter_mut().for_each(|m| *m = c);
         let mut settings = StepSettings::new(1e-4);
-        settings.mass_matrix = consistent(6, true);
+        settings.mass_matrix = consistent(6, 1.0);
         let mut sim = Simulation::new(kernel, material(1e3), Apic, particles, settings).unwrap();
         sim.step().unwrap();
         let (mass, velocity) = sim.grid();
@@ -110,7 +110,7 @@ fn iterations_keep_more_of_the_particle_field() {
         eprintln!("{name}: lumped keeps {:.4}", lumped.0);
         let mut last = lumped;
         for iterations in [1, 2, 4, 8] {
-            let now = shear_wave_kept(kernel.clone(), consistent(iterations, false));
+            let now = shear_wave_kept(kernel.clone(), consistent(iterations, 0.0));
             eprintln!("{name}: {iterations} iterations keep {:.4}", now.0);
             assert!(
                 now.0 > last.0 && now.0 <= 1.0 + 1e-9,
@@ -133,6 +133,88 @@ fn iterations_keep_more_of_the_particle_field() {
     check(grid(), "bspline2");
 }
 
+/// The nodal velocities after one step of a moving block whose deformation varies from
+/// particle to particle (so its stress has a divergence and the forces a rough part),
+/// with k iterations and the forces' share β.
+fn sheared_grid_velocity(iterations: usize, share: f64) -> Vec<Vector2<f64>> {
+    let mut particles = block(|x| Vector2::new(0.5 * (x.y - 0.5), 0.2 * (6.0 * x.x).sin()));
+    for (f, x) in particles.deformation.iter_mut().zip(&particles.position) {
+        *f = Matrix2::new(1.0 + 0.01 * (9.0 * x.y).sin(), 0.02 * x.x, 0.0, 1.0);
+    }
+    let mut settings = StepSettings::new(1e-4);
+    settings.mass_matrix = consistent(iterations, share);
+    let mut sim = Simulation::new(grid(), material(1e6), Apic, particles, settings).unwrap();
+    sim.step().unwrap();
+    sim.grid().1.to_vec()
+}
+
+/// The forces' matrix (1 − β) M_L + β M_C: the Jacobi update a ← a + β (f − M_C a)/m +
+/// (1 − β)(f/m − a) from the lumped a⁰ = f/m gives a¹ = a⁰ + β d, d = (f − M_C a⁰)/m,
+/// and a² = a⁰ + β d + β² (d − M_C d / m), so the change from β = 0 (the velocity's
+/// iterations alone) is linear in β after one iteration and quadratic after two:
+/// measured at β = ¼, predicted from β = ½ and 1.
+#[test]
+fn the_forces_share_enters_the_iterates_as_the_update_says() {
+    let change = |iterations, share| -> Vec<Vector2<f64>> {
+        let base = sheared_grid_velocity(iterations, 0.0);
+        sheared_grid_velocity(iterations, share)
+            .iter()
+            .zip(&base)
+            .map(|(v, b)| v - b)
+            .collect()
+    };
+    let largest = |field: &[Vector2<f64>]| field.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    // One iteration: linear.
+    let (whole, quarter) = (change(1, 1.0), change(1, 0.25));
+    assert!(
+        largest(&whole) > 1e-6,
+        "the forces' iterations change nothing"
+    );
+    let misfit: Vec<_> = quarter
+        .iter()
+        .zip(&whole)
+        .map(|(q, w)| q - w * 0.25)
+        .collect();
+    assert!(
+        largest(&misfit) < 1e-12 * largest(&whole).max(1.0),
+        "one iteration: {:e} off the linear prediction (change {:e})",
+        largest(&misfit),
+        largest(&whole)
+    );
+    // Two iterations: β X + β² Y through β = ½ and 1 predicts β = ¼, and X is the one
+    // iteration's d (the (1 − β) term cancels the second iteration's β d).
+    let d = whole;
+    let (whole, half, quarter) = (change(2, 1.0), change(2, 0.5), change(2, 0.25));
+    let first: Vec<_> = (0..d.len())
+        .map(|i| half[i] * 4.0 - whole[i] - d[i])
+        .collect();
+    assert!(
+        largest(&first) < 1e-12 * largest(&d).max(1.0),
+        "two iterations: first-order term {:e} off the one iteration's",
+        largest(&first)
+    );
+    let misfit: Vec<_> = (0..whole.len())
+        .map(|i| {
+            // X + Y = whole, X/2 + Y/4 = half  =>  Y = 2 whole − 4 half, X = 4 half − whole.
+            let y = whole[i] * 2.0 - half[i] * 4.0;
+            let x = half[i] * 4.0 - whole[i];
+            quarter[i] - (x * 0.25 + y * 0.0625)
+        })
+        .collect();
+    assert!(
+        largest(&misfit) < 1e-12 * largest(&whole).max(1.0),
+        "two iterations: {:e} off the quadratic prediction (change {:e})",
+        largest(&misfit),
+        largest(&whole)
+    );
+    // And the quadratic term is there: the mixed matrix is not a blend of the results.
+    let blend: Vec<_> = half.iter().zip(&whole).map(|(h, w)| h - w * 0.5).collect();
+    assert!(
+        largest(&blend) > 1e-3 * largest(&whole),
+        "no quadratic term"
+    );
+}
+
 /// A swirling, falling block on 1 and 2 threads, consistent mass on velocity and
 /// forces, FLIP and APIC: the same bits.
 #[test]
@@ -145,7 +227,7 @@ fn results_do_not_depend_on_the_thread_count() {
         pool.install(|| {
             let particles = block(|x| Vector2::new(-(x.y - 0.5), x.x - 0.5));
             let mut settings = StepSettings::new(1e-4);
-            settings.mass_matrix = consistent(3, true);
+            settings.mass_matrix = consistent(3, 1.0);
             settings.gravity = Vector2::new(0.0, -9.81);
             let mut sim = Simulation::new(
                 Umls2::new(mesh()),
@@ -167,20 +249,21 @@ fn results_do_not_depend_on_the_thread_count() {
 }
 
 /// MLS-MPM's momenta carry the force impulse, so it refuses the consistent matrix;
-/// zero iterations are refused by name; with forces solved the stable step shrinks by
-/// √k.
+/// zero iterations and a forces' share outside [0, 1] are refused by name; with forces
+/// solved the stable step shrinks by √k, with a share β by √(Σ_{j=1..k} β^j) when above
+/// 1.
 #[test]
 fn what_cannot_be_done_is_refused_and_the_stable_step_shrinks() {
     let particles = || block(|_| Vector2::zeros());
     let mut settings = StepSettings::new(1e-4);
-    settings.mass_matrix = consistent(2, false);
+    settings.mass_matrix = consistent(2, 0.0);
     match Simulation::new(grid(), material(1e4), MlsMpm, particles(), settings) {
         Err(EngineError::Unsupported { setting, .. }) => {
             assert!(setting.contains("mass"), "{setting}")
         }
         other => panic!("expected Unsupported, got {:?}", other.err()),
     }
-    settings.mass_matrix = consistent(0, true);
+    settings.mass_matrix = consistent(0, 1.0);
     match Simulation::new(grid(), material(1e4), Apic, particles(), settings) {
         Err(e @ EngineError::InvalidParameter { .. }) => {
             assert!(e.to_string().contains("mass_matrix.iterations"), "{e}")
@@ -195,6 +278,17 @@ fn what_cannot_be_done_is_refused_and_the_stable_step_shrinks() {
             .stable_time_step(1.0)
     };
     let lumped = stable(MassMatrix::Lumped);
-    assert_eq!(stable(consistent(4, false)), lumped);
-    assert!((stable(consistent(4, true)) - lumped / 2.0).abs() < 1e-15 * lumped);
+    assert_eq!(stable(consistent(4, 0.0)), lumped);
+    assert!((stable(consistent(4, 1.0)) - lumped / 2.0).abs() < 1e-15 * lumped);
+    // A share β divides by √(Σ_{j=1..k} β^j) when above 1: not at all for ½ with four
+    // iterations (0.9375), by 1.2 for 0.8 with two (1.44).
+    assert_eq!(stable(consistent(4, 0.5)), lumped);
+    assert!((stable(consistent(2, 0.8)) - lumped / 1.2).abs() < 1e-15 * lumped);
+    settings.mass_matrix = consistent(2, 1.5);
+    match Simulation::new(grid(), material(1e4), Apic, particles(), settings) {
+        Err(e @ EngineError::InvalidParameter { .. }) => {
+            assert!(e.to_string().contains("mass_matrix.forces"), "{e}")
+        }
+        other => panic!("expected InvalidParameter, got {:?}", other.err()),
+    }
 }

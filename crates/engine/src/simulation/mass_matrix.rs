@@ -24,6 +24,12 @@
 //! - a field the transfer reproduces (constant, or affine for affine transfers) is a
 //!   fixed point: the lumped solution is already its projection.
 //!
+//! The forces may take the matrix (1 − β) M_L + β A instead (β < 1; ½ is the mixed
+//! matrix, whose frequency errors from lumping and from the consistent matrix cancel
+//! in their leading term for linear elements): the update becomes
+//! v⁽ʳ⁺¹⁾ = v⁽ʳ⁾ + β (p − A v⁽ʳ⁾) / m + (1 − β)(p / m − v⁽ʳ⁾), whose iteration matrix is
+//! β times the consistent one's, so it converges faster.
+//!
 //! Each iteration is one gather and one scatter over the stencils, as costly as a G2P
 //! and a P2G of momentum only.
 
@@ -79,15 +85,15 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let velocity = mass.velocity_iterations();
         if velocity > 0 {
             let mut momentum = std::mem::take(&mut self.grid.momentum);
-            let solved = self.solve_mass_matrix(&mut momentum, velocity, T::AFFINE);
+            let solved = self.solve_mass_matrix(&mut momentum, velocity, 1.0, T::AFFINE);
             self.grid.momentum = momentum;
             solved?;
         }
         let forces = mass.force_iterations();
         if forces > 0 {
-            // Consistent mass in the equation of motion: the plain matrix, no affine part.
+            // The equation of motion's matrix: the plain one, no affine part, in its share.
             let mut force = std::mem::take(&mut self.grid.force);
-            let solved = self.solve_mass_matrix(&mut force, forces, false);
+            let solved = self.solve_mass_matrix(&mut force, forces, mass.force_share(), false);
             self.grid.force = force;
             solved?;
         }
@@ -95,12 +101,14 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     }
 
     /// Replaces `rhs` (m_i times a nodal field, summed by P2G) on active nodes by m_i
-    /// times the k-th Jacobi iterate of M x = rhs, where M is the consistent mass
-    /// matrix, with the transfer's affine part if `affine`, and k = `iterations`.
+    /// times the k-th Jacobi iterate of M x = rhs, k = `iterations`, where
+    /// M = (1 − β) M_L + β A, β = `share`, and A is the consistent mass matrix, with the
+    /// transfer's affine part if `affine`.
     fn solve_mass_matrix(
         &mut self,
         rhs: &mut [SVector<f64, D>],
         iterations: usize,
+        share: f64,
         affine: bool,
     ) -> Result<(), EngineError> {
         let step = self.step;
@@ -117,15 +125,20 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let grid = &self.grid;
         let active = |i: usize| grid.is_active(i, fraction);
         let rhs_in: &[SVector<f64, D>] = rhs;
-        // One Jacobi update v ← v + (rhs − A v) / m on the active nodes; the first,
-        // from v = 0 (no product), is the lumped v = rhs / m.
+        // One Jacobi update v ← v + (rhs − (1 − β) m v − β A v) / m on the active nodes,
+        // taken as v + β (rhs − A v) / m + (1 − β) (rhs / m − v), which for β = 1 is
+        // v + (rhs − A v) / m bit for bit; the first, from v = 0 (no product), is the
+        // lumped v = rhs / m.
         let jacobi = |velocity: &mut [SVector<f64, D>], product: Option<&[SVector<f64, D>]>| {
             velocity
                 .par_iter_mut()
                 .enumerate()
                 .with_min_len(NODE_CHUNK)
                 .for_each(|(i, v)| match (active(i), product) {
-                    (true, Some(product)) => *v += (rhs_in[i] - product[i]) / grid.mass[i],
+                    (true, Some(product)) => {
+                        let (rhs, m) = (rhs_in[i], grid.mass[i]);
+                        *v += (rhs - product[i]) / m * share + (rhs / m - *v) * (1.0 - share)
+                    }
                     (true, None) => *v = rhs_in[i] / grid.mass[i],
                     (false, Some(_)) => {}
                     (false, None) => *v = SVector::zeros(),
