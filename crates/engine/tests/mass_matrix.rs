@@ -164,55 +164,39 @@ fn the_forces_share_enters_the_iterates_as_the_update_says() {
             .collect()
     };
     let largest = |field: &[Vector2<f64>]| field.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    // A field that should vanish to round-off against the size of the change.
+    let round_off = |misfit: Vec<Vector2<f64>>, change: &[Vector2<f64>], what: &str| {
+        assert!(
+            largest(&misfit) < 1e-12 * largest(change).max(1.0),
+            "{what}: {:e} off (change {:e})",
+            largest(&misfit),
+            largest(change)
+        );
+    };
     // One iteration: linear.
-    let (whole, quarter) = (change(1, 1.0), change(1, 0.25));
-    assert!(
-        largest(&whole) > 1e-6,
-        "the forces' iterations change nothing"
-    );
-    let misfit: Vec<_> = quarter
-        .iter()
-        .zip(&whole)
-        .map(|(q, w)| q - w * 0.25)
-        .collect();
-    assert!(
-        largest(&misfit) < 1e-12 * largest(&whole).max(1.0),
-        "one iteration: {:e} off the linear prediction (change {:e})",
-        largest(&misfit),
-        largest(&whole)
-    );
+    let (d, quarter) = (change(1, 1.0), change(1, 0.25));
+    assert!(largest(&d) > 1e-6, "the forces' iterations change nothing");
+    let linear = quarter.iter().zip(&d).map(|(q, w)| q - w * 0.25).collect();
+    round_off(linear, &d, "one iteration, linear prediction");
     // Two iterations: β X + β² Y through β = ½ and 1 predicts β = ¼, and X is the one
     // iteration's d (the (1 − β) term cancels the second iteration's β d).
-    let d = whole;
+    // X + Y = whole, X/2 + Y/4 = half  =>  X = 4 half − whole, Y = 2 whole − 4 half.
     let (whole, half, quarter) = (change(2, 1.0), change(2, 0.5), change(2, 0.25));
-    let first: Vec<_> = (0..d.len())
-        .map(|i| half[i] * 4.0 - whole[i] - d[i])
+    let x: Vec<_> = (0..d.len()).map(|i| half[i] * 4.0 - whole[i]).collect();
+    let y: Vec<_> = (0..d.len())
+        .map(|i| whole[i] * 2.0 - half[i] * 4.0)
         .collect();
-    assert!(
-        largest(&first) < 1e-12 * largest(&d).max(1.0),
-        "two iterations: first-order term {:e} off the one iteration's",
-        largest(&first)
+    round_off(
+        (0..d.len()).map(|i| x[i] - d[i]).collect(),
+        &d,
+        "first-order term",
     );
-    let misfit: Vec<_> = (0..whole.len())
-        .map(|i| {
-            // X + Y = whole, X/2 + Y/4 = half  =>  Y = 2 whole − 4 half, X = 4 half − whole.
-            let y = whole[i] * 2.0 - half[i] * 4.0;
-            let x = half[i] * 4.0 - whole[i];
-            quarter[i] - (x * 0.25 + y * 0.0625)
-        })
+    let quadratic = (0..d.len())
+        .map(|i| quarter[i] - (x[i] * 0.25 + y[i] * 0.0625))
         .collect();
-    assert!(
-        largest(&misfit) < 1e-12 * largest(&whole).max(1.0),
-        "two iterations: {:e} off the quadratic prediction (change {:e})",
-        largest(&misfit),
-        largest(&whole)
-    );
+    round_off(quadratic, &whole, "two iterations, quadratic prediction");
     // And the quadratic term is there: the mixed matrix is not a blend of the results.
-    let blend: Vec<_> = half.iter().zip(&whole).map(|(h, w)| h - w * 0.5).collect();
-    assert!(
-        largest(&blend) > 1e-3 * largest(&whole),
-        "no quadratic term"
-    );
+    assert!(largest(&y) > 1e-3 * largest(&whole), "no quadratic term");
 }
 
 /// A swirling, falling block on 1 and 2 threads, consistent mass on velocity and
