@@ -90,8 +90,9 @@ pub enum MassMatrix {
     ///   (1 − β) M_L + β M_C, β = `forces`. β = 1 is the consistent-mass equation, whose
     ///   frequencies are those of the kernel's basis rather than of its lumping (the
     ///   vibrating bar's error halves). Lumping lowers a smooth mode's frequency and the
-    ///   consistent matrix raises it, so β = ½, the mixed matrix of finite elements
-    ///   (Krieg and Key), cancels most of both (the bar's error falls by another quarter,
+    ///   consistent matrix raises it; β = ½, the mixed matrix of finite elements (Krieg
+    ///   and Key), cancels their leading terms for linear elements (on the bar, UMLS's
+    ///   and bspline2's errors fall by another quarter, cubic B-splines' rise:
     ///   docs/umls-kernel.md, *Mass matrix*). k iterations raise the highest frequency,
     ///   so the stable Δt is divided by √(Σ_{j=1..k} β^j) when that exceeds 1: √k for
     ///   the consistent matrix ([`crate::Simulation::stable_time_step`]).
