@@ -449,7 +449,7 @@ pub struct MassSpec {
 /// `false` leaves them lumped, a number β ∈ [0, 1] uses (1 − β) M_L + β M_C (½: the mixed
 /// matrix).
 #[derive(Debug, Clone, Copy, Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "true, false or a share in [0, 1]")]
 pub enum ForceShare {
     /// All (1) or nothing (0).
     Whole(bool),

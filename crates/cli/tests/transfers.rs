@@ -6,7 +6,7 @@ use umls_cli::schema::KernelKind;
 
 #[path = "common/runs.rs"]
 mod runs;
-use runs::{metric, options, variant};
+use runs::{metric, options, variant, variant_text};
 
 /// The disks' summary with `kernel` and transfer `kind` (α 0.99 where it blends), the
 /// cells refined by `refine` (1: the scene's 20 × 20), run in the output directory
@@ -104,8 +104,8 @@ fn consistent_mass_keeps_the_disks_energy_under_apic() {
 
 /// `forces = 0.5` in `[transfer] mass`: the forces' mass matrix halfway between lumped
 /// and consistent (the mixed matrix). The scene file takes the share, the summary names
-/// it, the run differs from both ends' runs, and a share outside [0, 1] is refused by
-/// the parameter's name.
+/// it, the run differs from both ends' runs, a share outside [0, 1] is refused by the
+/// parameter's name, and a value of another kind by its line.
 #[test]
 fn a_forces_share_between_lumped_and_consistent_is_read_and_checked() {
     let bar = |forces: &str| {
@@ -144,6 +144,21 @@ fn a_forces_share_between_lumped_and_consistent_is_read_and_checked() {
     );
     let refused = bar("1.5").unwrap_err().to_string();
     assert!(refused.contains("mass_matrix.forces"), "{refused}");
+    // A value of the wrong kind is named by its line and what the key takes.
+    let text = variant_text(
+        "vibrating-bar",
+        &[(
+            "kind = \"apic\"",
+            "kind = \"apic\"\nmass = { iterations = 2, forces = \"yes\" }",
+        )],
+    );
+    let refused = umls_cli::scene::Scene::parse(&text, "bar.toml", None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        refused.contains("line") && refused.contains("true, false or a share in [0, 1]"),
+        "{refused}"
+    );
 }
 
 /// Sharpened distance weights (`umls-sharp`: the cubic B-spline divided by 1 + (r/ε)²,

@@ -37,6 +37,11 @@ pub fn completed_metric(scene: &Scene, name: &str, kernel: KernelKind, key: &str
 
 /// The built-in scene with each `find` replaced by its `replace` (which must occur).
 pub fn variant(name: &str, edits: &[(&str, &str)]) -> Scene {
+    Scene::parse(&variant_text(name, edits), "variant.toml", None).unwrap()
+}
+
+/// The text of [`variant`], for edits the parser is meant to refuse.
+pub fn variant_text(name: &str, edits: &[(&str, &str)]) -> String {
     let mut text = umls_cli::builtin::BUILTIN
         .iter()
         .find(|b| b.name == name)
@@ -47,7 +52,7 @@ pub fn variant(name: &str, edits: &[(&str, &str)]) -> Scene {
         assert!(text.contains(find), "{find}");
         text = text.replacen(find, replace, 1);
     }
-    Scene::parse(&text, "variant.toml", None).unwrap()
+    text
 }
 
 /// The header and rows of a run's `history.csv`.
