@@ -101,17 +101,22 @@ const CONSISTENT: MassMatrix = MassMatrix::Consistent {
 };
 
 /// The bar at `cells` with UMLS (cubic B-spline weights, incident-edge support `factor`),
-/// APIC and the [`CONSISTENT`] mass matrix.
-fn consistent_umls_bar(cells: usize, factor: f64) -> BarError {
+/// APIC and `mass_matrix`.
+fn umls_bar_with(cells: usize, factor: f64, mass_matrix: MassMatrix) -> BarError {
     let bar = level(cells);
     let mesh = Arc::new(bar.mesh().unwrap());
     let kernel =
         UmlsKernel::with_weight(&mesh, CubicBSpline, SupportRadius::IncidentEdge { factor })
             .unwrap();
     bar.run_with(Umls1::with_kernel(mesh, kernel), Apic, |s| {
-        s.mass_matrix = CONSISTENT
+        s.mass_matrix = mass_matrix
     })
     .unwrap()
+}
+
+/// [`umls_bar_with`] the [`CONSISTENT`] mass matrix.
+fn consistent_umls_bar(cells: usize, factor: f64) -> BarError {
+    umls_bar_with(cells, factor, CONSISTENT)
 }
 
 /// With the consistent mass matrix (two iterations, forces included) for both kernels,
@@ -380,13 +385,7 @@ fn the_mixed_matrix_lowers_both_kernels_error_below_lumped_and_consistent() {
     let cells = [32usize, 64];
     let umls_mixed: Vec<BarError> = cells
         .iter()
-        .map(|&c| {
-            let bar = level(c);
-            bar.run_with(Umls1::new(Arc::new(bar.mesh().unwrap())), Apic, |s| {
-                s.mass_matrix = mixed
-            })
-            .unwrap()
-        })
+        .map(|&c| umls_bar_with(c, DEFAULT_SUPPORT_FACTOR, mixed))
         .collect();
     let orders = orders(&umls_mixed);
     eprintln!("UMLS + APIC, mixed forces' matrix: {umls_mixed:?}, orders {orders:?}");
