@@ -154,10 +154,12 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
     Ok(ParticleUpdate {
         velocity: transfer.velocity(old, &pic, &flip),
         position: x + pic * dt,
-        affine_moment: if T::AFFINE {
-            (affine * d * affine.transpose()).trace()
-        } else {
-            0.0
+        // tr(C D Cᵀ), which P2G's limiter compares with at the next position; with
+        // D = s I it is s |C|² (and P2G reads it only where D varies).
+        affine_moment: match (T::AFFINE, moment_scale) {
+            (false, _) => 0.0,
+            (true, Some(s)) => s * affine.norm_squared(),
+            (true, None) => (affine * d * affine.transpose()).trace(),
         },
         affine,
         // MLS-MPM takes C_p as the velocity gradient (its ∇N is D⁻¹ N r).

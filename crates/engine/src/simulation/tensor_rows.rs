@@ -8,7 +8,8 @@
 //! their offsets' share of C r (P2G) and of B = Σ N v_i r_iᵀ and ∇v (G2P). The sums are
 //! kept in plain arrays: in nalgebra's column views the compiler shuffled them between
 //! vector lanes at every entry. They are grouped differently from the entry-by-entry
-//! loops, so results agree with those to round-off, not bit for bit.
+//! loops, and G2P's are fused multiply-adds where the CPU has FMA ([`fma`]), so results
+//! agree with those to round-off, not bit for bit.
 
 use nalgebra::{SMatrix, SVector};
 use umls_transfer::{Kernel, TensorStencil};
@@ -69,6 +70,18 @@ fn row_factors<const D: usize, const W: usize>(
         g
     });
     (node, weight, gradient)
+}
+
+/// a·b + c, rounded once where the build's CPU has FMA (one instruction, which shortens
+/// the chains of G2P's row sums: G2P 15 % faster on the fluid box), else multiplied and
+/// added as written (`f64::mul_add` without FMA is a library call).
+#[inline(always)]
+fn fma(a: f64, b: f64, c: f64) -> f64 {
+    if cfg!(target_feature = "fma") {
+        a.mul_add(b, c)
+    } else {
+        a * b + c
+    }
 }
 
 /// A matrix's columns as plain arrays.
@@ -200,38 +213,38 @@ pub(super) fn gather_rows<const D: usize, const W: usize, T: TransferScheme>(
             let dw = t.derivatives[0][a];
             for j in 0..D {
                 let v = velocities[a][j];
-                row[j] += v * w;
+                row[j] = fma(v, w, row[j]);
                 if T::USES_MOMENTS {
-                    row_moment[j] += v * wr;
+                    row_moment[j] = fma(v, wr, row_moment[j]);
                 }
                 if !T::FUSED_FORCE {
-                    row_derivative[j] += v * dw;
+                    row_derivative[j] = fma(v, dw, row_derivative[j]);
                 }
                 if T::USES_FLIP {
-                    row_flip[j] += (v - old[node + a][j]) * w;
+                    row_flip[j] = fma(v - old[node + a][j], w, row_flip[j]);
                 }
             }
         }
         for j in 0..D {
-            pic[j] += row[j] * weight;
+            pic[j] = fma(row[j], weight, pic[j]);
             if T::USES_FLIP {
-                flip[j] += row_flip[j] * weight;
+                flip[j] = fma(row_flip[j], weight, flip[j]);
             }
             if T::USES_MOMENTS {
-                b[0][j] += row_moment[j] * weight;
+                b[0][j] = fma(row_moment[j], weight, b[0][j]);
             }
             if !T::FUSED_FORCE {
-                grad_v[0][j] += row_derivative[j] * weight;
+                grad_v[0][j] = fma(row_derivative[j], weight, grad_v[0][j]);
             }
         }
         for k in 1..D {
             let offset = weight * t.offsets[k][digits[k]];
             for j in 0..D {
                 if T::USES_MOMENTS {
-                    b[k][j] += row[j] * offset;
+                    b[k][j] = fma(row[j], offset, b[k][j]);
                 }
                 if !T::FUSED_FORCE {
-                    grad_v[k][j] += row[j] * gradient[k];
+                    grad_v[k][j] = fma(row[j], gradient[k], grad_v[k][j]);
                 }
             }
         }
