@@ -101,6 +101,11 @@ impl<const D: usize> SceneFrame<D> {
         self.rotation * v
     }
 
+    /// A scene-frame tensor (an affine velocity matrix) in the world: R t Rᵀ.
+    pub fn tensor_to_world(&self, t: &SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
+        self.rotation * t * self.rotation.transpose()
+    }
+
     /// A world tensor (stress) in the scene frame: Rᵀ σ R.
     pub fn tensor_to_scene(&self, t: &SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
         self.rotation.transpose() * t * self.rotation

@@ -561,6 +561,7 @@ fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
     );
     particles.mass.clone_from(&seeds.mass);
     particles.velocity.clone_from(&seeds.velocity);
+    particles.affine.clone_from(&seeds.affine);
     for (state, &m) in particles.state.iter_mut().zip(&seeds.material) {
         state.material = m;
     }

@@ -822,6 +822,20 @@ pub struct BodySpec {
     pub jitter: Option<JitterSpec>,
     /// Initial velocity (D components, numbers or expressions in x, y, z); zero if absent.
     pub velocity: Option<Vec<Component>>,
+    /// What the particles' affine matrices C_p start from (default zero).
+    #[serde(default)]
+    pub affine: AffineStartSpec,
+}
+
+/// `[[bodies]] affine`: the affine matrices' start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AffineStartSpec {
+    /// C_p = 0.
+    #[default]
+    Zero,
+    /// C_p = ∇v of the body's `velocity` field at the particle (central differences).
+    VelocityGradient,
 }
 
 /// Boundary kinds.

@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 use umls_constitutive::{
     ConeFit, DruckerPrager, ElasticParameters, ElastoPlastic, FixedCorotated, LinearElastic,
     NeoHookean, StVenantKirchhoff, VonMises, WeaklyCompressibleFluid,
@@ -22,8 +22,9 @@ use crate::jitter::Jitter;
 use crate::probes::ProbeReference;
 use crate::scene::Scene;
 use crate::schema::{
-    BoundaryKind, DiagonalSpec, ForcePosition, Imposed, MaterialSpec, QuadratureSpec, RegionSpec,
-    SeedingSpec, SolidSpec, StressUpdateSpec, VelocityTimeSpec,
+    AffineStartSpec, BoundaryKind, DiagonalSpec, ForcePosition, Imposed, MaterialSpec,
+    QuadratureSpec, RegionSpec, SeedingSpec, SolidSpec, StressUpdateSpec, TransferKind,
+    VelocityTimeSpec,
 };
 use umls_constitutive::table::{ElasticModel, Model, PlasticModel};
 
@@ -44,6 +45,8 @@ pub struct Seeds<const D: usize> {
     pub mass: Vec<f64>,
     /// Initial velocities.
     pub velocity: Vec<SVector<f64, D>>,
+    /// Initial affine matrices C_p (zero unless a body's `affine` says otherwise).
+    pub affine: Vec<SMatrix<f64, D, D>>,
     /// Material index.
     pub material: Vec<u16>,
 }
@@ -415,6 +418,38 @@ pub(crate) fn region<const D: usize>(
     })
 }
 
+/// ∇v of `field` at `x` (entry (j, k) = ∂v_j/∂x_k) by fourth-order central differences
+/// with step 10⁻³ `spacing` (the particle's own spacing): truncation of order
+/// (10⁻³ spacing / λ)⁴ for a field varying on a length λ, round-off of order
+/// 10⁻¹³ λ / spacing, relative to the gradient. Exact for polynomials of degree ≤ 4.
+fn velocity_gradient<const D: usize>(
+    field: &VectorField<D>,
+    x: &SVector<f64, D>,
+    spacing: f64,
+) -> std::result::Result<SMatrix<f64, D, D>, String> {
+    let step = 1e-3 * spacing;
+    let mut gradient = SMatrix::<f64, D, D>::zeros();
+    for k in 0..D {
+        let at = |offset: f64| {
+            let mut y = *x;
+            y[k] += offset * step;
+            field.eval(&y, 0.0)
+        };
+        let column = (at(-2.0)? - at(2.0)? + (at(1.0)? - at(-1.0)?) * 8.0) / (12.0 * step);
+        if !column.iter().all(|c| c.is_finite()) {
+            return Err(format!(
+                "has no finite gradient at the particle ({}) for `affine = \"velocity-gradient\"`",
+                x.iter()
+                    .map(|c| format!("{c}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+        gradient.set_column(k, &column);
+    }
+    Ok(gradient)
+}
+
 fn seed_body<const D: usize>(
     scene: &Scene,
     index: usize,
@@ -536,6 +571,23 @@ fn seed_body<const D: usize>(
                 .map_err(|reason| scene.value_error(key("velocity"), reason))?,
         ),
     };
+    if body.affine == AffineStartSpec::VelocityGradient {
+        if velocity.is_none() {
+            return Err(scene.value_error(
+                key("affine"),
+                "starts C_p at the gradient of `velocity`, which is not given",
+            ));
+        }
+        if matches!(
+            scene.spec.transfer.kind,
+            TransferKind::Pic | TransferKind::Flip
+        ) {
+            return Err(scene.value_error(
+                key("affine"),
+                "sets the affine matrices, which `transfer.kind` (pic or flip) does not carry",
+            ));
+        }
+    }
     let jitter = match (&body.jitter, &body.seeding) {
         (None, _) => None,
         (Some(_), SeedingSpec::Mesh(_)) => {
@@ -595,6 +647,13 @@ fn seed_body<const D: usize>(
         seeds.volume.push(*volume);
         seeds.mass.push(volume * density);
         seeds.velocity.push(v);
+        seeds.affine.push(match (&velocity, body.affine) {
+            (Some(field), AffineStartSpec::VelocityGradient) => {
+                velocity_gradient(field, x, volume.powf(1.0 / D as f64))
+                    .map_err(|reason| scene.value_error(key("velocity"), reason))?
+            }
+            _ => SMatrix::zeros(),
+        });
         seeds.material.push(material);
     }
     if seeds.position.len() == before {
@@ -1010,6 +1069,9 @@ pub fn build_for<const D: usize>(
         }
         for v in &mut seeds.velocity {
             *v = frame.vector_to_world(v);
+        }
+        for c in &mut seeds.affine {
+            *c = frame.tensor_to_world(c);
         }
         for (_, target) in &mut boundaries {
             match target {

@@ -4,7 +4,7 @@
 use umls_cli::CliError;
 use umls_cli::run::{RunOptions, run};
 use umls_cli::scene::Scene;
-use umls_cli::setup::{build, triangles};
+use umls_cli::setup::{build, segments, triangles};
 use umls_engine::Apic;
 use umls_kernels::{Umls1, Umls2};
 use umls_scenes::colliding_disks::CollidingDisks;
@@ -131,6 +131,123 @@ fn bar_file_matches_the_hand_written_scene_error() {
     );
     // Second-order UMLS on 50 cells: the error is small.
     assert!(file_rmse < 2e-3, "{file_rmse}");
+}
+
+/// `affine = "velocity-gradient"` starts a body's C_p at ∇v of its `velocity`: the bar
+/// file's matrices are the hand-written scene's `AffineStart::VelocityGradient` ones and
+/// its run gives that scene's error; in 2D a polynomial field's gradient comes out exact
+/// (fourth-order differences), turned with the scene by `[transform]`, and only on the
+/// body that asks; the key is refused without a velocity or with a transfer that has no
+/// affine matrices.
+#[test]
+fn a_body_starts_its_affine_matrices_at_the_velocity_gradient() {
+    use umls_scenes::vibrating_bar::AffineStart;
+    let sine = r#"velocity = ["0.1 * sin(PI * x / 50)"]"#;
+    let scene = with(
+        "vibrating-bar",
+        sine,
+        &format!("{sine}\naffine = \"velocity-gradient\""),
+    );
+    let seeds = build::<1>(&scene, segments).unwrap().seeds;
+    let bar = VibratingBar {
+        cells: 50,
+        affine_start: AffineStart::VelocityGradient,
+        ..VibratingBar::default()
+    };
+    let expected = bar.particles::<()>();
+    let largest = expected.affine.iter().fold(0.0f64, |m, c| m.max(c.amax()));
+    assert!(largest > 6e-3, "{largest}");
+    let mut pairs: Vec<(f64, f64)> = seeds
+        .position
+        .iter()
+        .zip(&seeds.affine)
+        .map(|(x, c)| (x[0], c[(0, 0)]))
+        .collect();
+    let mut wanted: Vec<(f64, f64)> = expected
+        .position
+        .iter()
+        .zip(&expected.affine)
+        .map(|(x, c)| (x[0], c[(0, 0)]))
+        .collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    wanted.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert_eq!(pairs.len(), wanted.len());
+    for (got, want) in pairs.iter().zip(&wanted) {
+        assert!((got.0 - want.0).abs() < 1e-12, "{got:?} {want:?}");
+        assert!((got.1 - want.1).abs() < 1e-10 * largest, "{got:?} {want:?}");
+    }
+    let report = run(&scene, &options("bar-file-affine", None)).unwrap();
+    let file_rmse = report.summary["metrics"]["velocity_rmse"].as_f64().unwrap();
+    let mesh = std::sync::Arc::new(bar.mesh().unwrap());
+    let started = bar
+        .run(Umls1::new(mesh.clone()), Apic)
+        .unwrap()
+        .velocity_rmse;
+    let zero = VibratingBar {
+        cells: 50,
+        ..VibratingBar::default()
+    }
+    .run(Umls1::new(mesh), Apic)
+    .unwrap()
+    .velocity_rmse;
+    assert!(
+        (file_rmse - started).abs() < 1e-8 * started,
+        "{file_rmse} vs {started}"
+    );
+    assert!((started - zero).abs() > 1e-3 * zero, "{started} vs {zero}");
+
+    // 2D: a cubic field on the first disk, the scene turned by 90° about (0.5, 0.5).
+    let mut text = umls_cli::builtin::BUILTIN
+        .iter()
+        .find(|b| b.name == "colliding-disks")
+        .unwrap()
+        .toml
+        .replacen(r#"kind = "flip""#, r#"kind = "apic""#, 1)
+        .replacen(
+            "velocity = [0.1, 0.1]",
+            "velocity = [\"0.1 + x * y - 2 * y^2\", \"0.3 * x^3\"]\naffine = \"velocity-gradient\"",
+            1,
+        );
+    text.push_str("\n[transform]\nrotation = 90.0\ncentre = [0.5, 0.5]\n");
+    let scene = Scene::parse(&text, "affine.toml", None).unwrap();
+    let seeds = build::<2>(&scene, triangles).unwrap().seeds;
+    let turn = nalgebra::Matrix2::new(0.0, -1.0, 1.0, 0.0);
+    let centre = nalgebra::Vector2::new(0.5, 0.5);
+    let (mut first, mut second) = (0, 0);
+    for (world, c) in seeds.position.iter().zip(&seeds.affine) {
+        let x = turn.transpose() * (world - centre) + centre;
+        if (x - nalgebra::Vector2::new(0.2, 0.2)).norm() < 0.21 {
+            let gradient = nalgebra::Matrix2::new(x[1], x[0] - 4.0 * x[1], 0.9 * x[0] * x[0], 0.0);
+            let want = turn * gradient * turn.transpose();
+            assert!((c - want).amax() < 1e-9, "at {x}: {c} against {want}");
+            first += 1;
+        } else {
+            assert_eq!(*c, nalgebra::Matrix2::zeros(), "second disk at {x}");
+            second += 1;
+        }
+    }
+    assert!(first > 100 && second > 100, "{first} {second}");
+
+    // Refused, naming the key.
+    let refused = |scene: Result<Scene, CliError>| {
+        let message = match scene.and_then(|s| build::<1>(&s, segments).map(|_| ())) {
+            Err(e) => e.to_string(),
+            Ok(()) => panic!("accepted"),
+        };
+        assert!(message.contains("bodies[0].affine"), "{message}");
+        message
+    };
+    let text = umls_cli::builtin::BUILTIN
+        .iter()
+        .find(|b| b.name == "vibrating-bar")
+        .unwrap()
+        .toml;
+    let flip = text
+        .replacen(sine, &format!("{sine}\naffine = \"velocity-gradient\""), 1)
+        .replacen(r#"kind = "apic""#, r#"kind = "flip""#, 1);
+    assert!(refused(Scene::parse(&flip, "flip.toml", None)).contains("pic or flip"));
+    let still = text.replacen(sine, r#"affine = "velocity-gradient""#, 1);
+    assert!(refused(Scene::parse(&still, "still.toml", None)).contains("not given"));
 }
 
 fn with(text: &str, find: &str, replace: &str) -> Scene {

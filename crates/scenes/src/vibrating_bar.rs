@@ -12,7 +12,7 @@
 
 use std::f64::consts::PI;
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 use umls_constitutive::{ConstitutiveError, ElasticParameters, LinearElastic};
 use umls_engine::{EngineError, Particles, Simulation, StepSettings, TransferScheme};
 use umls_mesh::generate::Lattice;
@@ -27,6 +27,18 @@ pub enum FixedEnd {
     Mirror,
     /// Fix the velocity of the mesh vertex at x = 0 (node 0).
     Node,
+}
+
+/// What the particles' affine matrices C_p start from (read by affine transfers: APIC,
+/// APIC-FLIP, the velocity-gradient transfer; the others ignore it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AffineStart {
+    /// C_p = 0, as a particle set starts without further information.
+    #[default]
+    Zero,
+    /// C_p = ∂v/∂x at the particle, v₀ β cos(βx): the initial field's own gradient, so
+    /// the first P2G spreads the sine as it is instead of as a constant per particle.
+    VelocityGradient,
 }
 
 /// Parameters of the scene.
@@ -50,6 +62,8 @@ pub struct VibratingBar {
     pub periods: f64,
     /// How the fixed end is imposed.
     pub fixed_end: FixedEnd,
+    /// What the affine matrices start from.
+    pub affine_start: AffineStart,
 }
 
 impl Default for VibratingBar {
@@ -66,6 +80,7 @@ impl Default for VibratingBar {
             courant: 0.1,
             periods: 1.0,
             fixed_end: FixedEnd::Mirror,
+            affine_start: AffineStart::Zero,
         }
     }
 }
@@ -112,8 +127,13 @@ impl VibratingBar {
         }
     }
 
+    /// Analytic velocity gradient ∂v/∂x at reference position `x` and time `t`.
+    pub fn velocity_gradient(&self, x: f64, t: f64) -> f64 {
+        self.amplitude * self.beta() * (self.omega() * t).cos() * (self.beta() * x).cos()
+    }
+
     /// Particles at the midpoints of equal sub-cells (and their mirror images under
-    /// [`FixedEnd::Mirror`]), v(x, 0) = v₀ sin(βx).
+    /// [`FixedEnd::Mirror`]), v(x, 0) = v₀ sin(βx), C_p as [`Self::affine_start`] says.
     pub fn particles<C: Copy + Default>(&self) -> Particles<1, (), C> {
         let n = self.cells * self.particles_per_cell;
         let h = self.dx() / self.particles_per_cell as f64;
@@ -128,6 +148,11 @@ impl VibratingBar {
         let mut p = Particles::at_rest(x, vec![h; n], self.density, ());
         for (v, x) in p.velocity.iter_mut().zip(&p.position) {
             *v = SVector::from([self.velocity(x[0], 0.0)]);
+        }
+        if self.affine_start == AffineStart::VelocityGradient {
+            for (c, x) in p.affine.iter_mut().zip(&p.position) {
+                *c = SMatrix::from([[self.velocity_gradient(x[0], 0.0)]]);
+            }
         }
         p
     }
