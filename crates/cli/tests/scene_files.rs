@@ -157,20 +157,14 @@ fn a_body_starts_its_affine_matrices_at_the_velocity_gradient() {
     let expected = bar.particles::<()>();
     let largest = expected.affine.iter().fold(0.0f64, |m, c| m.max(c.amax()));
     assert!(largest > 6e-3, "{largest}");
-    let mut pairs: Vec<(f64, f64)> = seeds
-        .position
-        .iter()
-        .zip(&seeds.affine)
-        .map(|(x, c)| (x[0], c[(0, 0)]))
-        .collect();
-    let mut wanted: Vec<(f64, f64)> = expected
-        .position
-        .iter()
-        .zip(&expected.affine)
-        .map(|(x, c)| (x[0], c[(0, 0)]))
-        .collect();
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    wanted.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // (x, C) pairs sorted by x: the comparison does not depend on the seeding order.
+    let by_position = |x: &[nalgebra::Vector1<f64>], c: &[nalgebra::Matrix1<f64>]| {
+        let mut pairs: Vec<(f64, f64)> = x.iter().zip(c).map(|(x, c)| (x[0], c[(0, 0)])).collect();
+        pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+        pairs
+    };
+    let pairs = by_position(&seeds.position, &seeds.affine);
+    let wanted = by_position(&expected.position, &expected.affine);
     assert_eq!(pairs.len(), wanted.len());
     for (got, want) in pairs.iter().zip(&wanted) {
         assert!((got.0 - want.0).abs() < 1e-12, "{got:?} {want:?}");
