@@ -418,6 +418,14 @@ pub(crate) fn region<const D: usize>(
     })
 }
 
+/// A point's or vector's components as "a, b, c", for messages.
+fn listed<const D: usize>(u: &SVector<f64, D>) -> String {
+    u.iter()
+        .map(|c| format!("{c}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// ∇v of `field` at `x` (entry (j, k) = ∂v_j/∂x_k) by fourth-order central differences
 /// with step 10⁻³ `spacing` (the particle's own spacing): truncation of order
 /// (10⁻³ spacing / λ)⁴ for a field varying on a length λ, round-off of order
@@ -439,10 +447,7 @@ fn velocity_gradient<const D: usize>(
         if !column.iter().all(|c| c.is_finite()) {
             return Err(format!(
                 "has no finite gradient at the particle ({}) for `affine = \"velocity-gradient\"`",
-                x.iter()
-                    .map(|c| format!("{c}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                listed(x)
             ));
         }
         gradient.set_column(k, &column);
@@ -628,18 +633,12 @@ fn seed_body<const D: usize>(
         // An infinite or undefined velocity (1/0, or 1/(x − a) at a particle on x = a)
         // would poison the whole run.
         if !v.iter().all(|c| c.is_finite()) {
-            let list = |u: &SVector<f64, D>| {
-                u.iter()
-                    .map(|c| format!("{c}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
             return Err(scene.value_error(
                 key("velocity"),
                 format!(
                     "is ({}) at the particle ({}): not finite",
-                    list(&v),
-                    list(x)
+                    listed(&v),
+                    listed(x)
                 ),
             ));
         }

@@ -10,6 +10,10 @@ use umls_kernels::{Umls1, Umls2};
 use umls_scenes::colliding_disks::CollidingDisks;
 use umls_scenes::vibrating_bar::VibratingBar;
 
+#[path = "common/runs.rs"]
+mod runs;
+use runs::variant_text;
+
 fn options(name: &str, end_time: Option<f64>) -> RunOptions {
     RunOptions {
         kernel: None,
@@ -191,17 +195,16 @@ fn a_body_starts_its_affine_matrices_at_the_velocity_gradient() {
     assert!((started - zero).abs() > 1e-3 * zero, "{started} vs {zero}");
 
     // 2D: a cubic field on the first disk, the scene turned by 90° about (0.5, 0.5).
-    let mut text = umls_cli::builtin::BUILTIN
-        .iter()
-        .find(|b| b.name == "colliding-disks")
-        .unwrap()
-        .toml
-        .replacen(r#"kind = "flip""#, r#"kind = "apic""#, 1)
-        .replacen(
-            "velocity = [0.1, 0.1]",
-            "velocity = [\"0.1 + x * y - 2 * y^2\", \"0.3 * x^3\"]\naffine = \"velocity-gradient\"",
-            1,
-        );
+    let mut text = variant_text(
+        "colliding-disks",
+        &[
+            (r#"kind = "flip""#, r#"kind = "apic""#),
+            (
+                "velocity = [0.1, 0.1]",
+                "velocity = [\"0.1 + x * y - 2 * y^2\", \"0.3 * x^3\"]\naffine = \"velocity-gradient\"",
+            ),
+        ],
+    );
     text.push_str("\n[transform]\nrotation = 90.0\ncentre = [0.5, 0.5]\n");
     let scene = Scene::parse(&text, "affine.toml", None).unwrap();
     let seeds = build::<2>(&scene, triangles).unwrap().seeds;
@@ -231,31 +234,23 @@ fn a_body_starts_its_affine_matrices_at_the_velocity_gradient() {
         assert!(message.contains("bodies[0].affine"), "{message}");
         message
     };
-    let text = umls_cli::builtin::BUILTIN
-        .iter()
-        .find(|b| b.name == "vibrating-bar")
-        .unwrap()
-        .toml;
-    let flip = text
-        .replacen(sine, &format!("{sine}\naffine = \"velocity-gradient\""), 1)
-        .replacen(r#"kind = "apic""#, r#"kind = "flip""#, 1);
+    let flip = variant_text(
+        "vibrating-bar",
+        &[
+            (sine, &format!("{sine}\naffine = \"velocity-gradient\"")),
+            (r#"kind = "apic""#, r#"kind = "flip""#),
+        ],
+    );
     assert!(refused(Scene::parse(&flip, "flip.toml", None)).contains("pic or flip"));
-    let still = text.replacen(sine, r#"affine = "velocity-gradient""#, 1);
+    let still = variant_text(
+        "vibrating-bar",
+        &[(sine, r#"affine = "velocity-gradient""#)],
+    );
     assert!(refused(Scene::parse(&still, "still.toml", None)).contains("not given"));
 }
 
 fn with(text: &str, find: &str, replace: &str) -> Scene {
-    let builtin = umls_cli::builtin::BUILTIN
-        .iter()
-        .find(|b| b.name == text)
-        .unwrap();
-    assert!(builtin.toml.contains(find), "{find}");
-    Scene::parse(
-        &builtin.toml.replacen(find, replace, 1),
-        "edited.toml",
-        None,
-    )
-    .unwrap()
+    Scene::parse(&variant_text(text, &[(find, replace)]), "edited.toml", None).unwrap()
 }
 
 fn message(scene_name: &str, find: &str, replace: &str) -> String {
