@@ -13,8 +13,9 @@ use std::time::Instant;
 use nalgebra::{SMatrix, SVector};
 use serde_json::json;
 use umls_engine::{
-    Apic, ApicFlip, Boundary, Diagnostics, EngineError, Flip, MlsMpm, Particles, Simulation,
-    StageTimes, StepSettings, TimeStepControl, TransferScheme, VelocityGradientAffine, Wall,
+    Apic, ApicFlip, Boundary, Diagnostics, EngineError, Flip, MlsMpm, Particles, QuadraticApicFlip,
+    Simulation, StageTimes, StepSettings, TimeStepControl, TransferScheme, VelocityGradientAffine,
+    Wall,
 };
 use umls_io::csv::HistoryWriter;
 use umls_io::vtk::Encoding;
@@ -480,6 +481,10 @@ fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
         TransferKind::Flip => start(ctx, kernel, table, Flip { alpha: t.alpha }),
         TransferKind::ApicFlip => start(ctx, kernel, table, ApicFlip { alpha: t.alpha }),
         TransferKind::Apic => start(ctx, kernel, table, AffineTransfer::Apic),
+        TransferKind::QuadraticApic => start(ctx, kernel, table, QuadraticApicFlip { alpha: 0.0 }),
+        TransferKind::QuadraticApicFlip => {
+            start(ctx, kernel, table, QuadraticApicFlip { alpha: t.alpha })
+        }
         TransferKind::VelocityGradient => {
             start(ctx, kernel, table, AffineTransfer::VelocityGradient)
         }
@@ -766,6 +771,8 @@ fn transfer_kind_name(spec: &crate::schema::TransferSpec) -> String {
         TransferKind::Flip => format!("flip (alpha {})", spec.alpha),
         TransferKind::ApicFlip => format!("apic-flip (alpha {})", spec.alpha),
         TransferKind::Apic => "apic".into(),
+        TransferKind::QuadraticApic => "quadratic-apic".into(),
+        TransferKind::QuadraticApicFlip => format!("quadratic-apic-flip (alpha {})", spec.alpha),
         TransferKind::VelocityGradient => "velocity-gradient".into(),
         TransferKind::MlsMpm => "mls-mpm".into(),
     }

@@ -412,6 +412,12 @@ pub enum TransferKind {
     Apic,
     /// FLIP blended with APIC by `alpha`: APIC's affine P2G, FLIP's velocity update.
     ApicFlip,
+    /// APIC with quadratic velocity modes (after PolyPIC): the particles also carry the
+    /// coefficients of the centred quadratic modes, which the round trip keeps.
+    QuadraticApic,
+    /// FLIP blended with quadratic APIC by `alpha`: quadratic APIC's P2G, FLIP's velocity
+    /// update.
+    QuadraticApicFlip,
     /// Affine transfer with C = ∇v.
     VelocityGradient,
     /// MLS-MPM: APIC with the force folded into the affine momentum and ∇v = C (Hu et
@@ -426,7 +432,8 @@ pub struct TransferSpec {
     /// Which scheme (default `flip`).
     #[serde(default)]
     pub kind: TransferKind,
-    /// FLIP fraction of `flip` and `apic-flip`, in [0, 1] (default 0.99).
+    /// FLIP fraction of `flip`, `apic-flip` and `quadratic-apic-flip`, in [0, 1] (default
+    /// 0.99).
     #[serde(default = "default_alpha")]
     pub alpha: f64,
     /// The consistent mass matrix, `{ iterations = k, forces = … }` (default: lumped;

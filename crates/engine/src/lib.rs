@@ -1,9 +1,11 @@
 //! Explicit material point method, generic over dimension, shape-function kernel
 //! ([`umls_transfer::Kernel`]), transfer scheme ([`TransferScheme`]: PIC, FLIP, APIC,
-//! velocity-gradient affine) and material ([`umls_constitutive::Constitutive`]).
+//! APIC-FLIP, quadratic APIC ([`quadratic_modes`]), velocity-gradient affine, MLS-MPM)
+//! and material ([`umls_constitutive::Constitutive`]).
 //!
 //! One [`Simulation::step`]: evaluate every particle's stencil (in parallel, walking from
-//! its cached host), P2G of mass, momentum (with the affine term for affine schemes) and
+//! its cached host), P2G of mass, momentum (with the affine term, and the quadratic
+//! modes, for the schemes that carry them) and
 //! force (−Σ V⁰ τ ∇N + gravity and body forces), grid update (empty and mass-scaled nodes,
 //! damping, boundary conditions: node sets, walls, clamps imposed on the fit
 //! ([`FittedClamp`])), G2P of velocity, affine matrix and position, walls that
@@ -58,6 +60,7 @@ mod grid;
 mod memory;
 mod parallel;
 mod particles;
+pub mod quadratic_modes;
 mod scatter;
 mod seeding;
 mod settings;
@@ -72,10 +75,12 @@ pub use error::EngineError;
 pub use fitted_clamp::{FITTED_CLAMP_REGULARISATION, FittedClamp};
 pub use memory::MemoryUse;
 pub use particles::Particles;
+pub use quadratic_modes::{MAX_QUADRATIC_MODES, QUADRATIC_RIDGE, QuadraticModes};
 pub use seeding::{Inside, Region, lattice_points, lattice_samples};
 pub use settings::{Damping, MassMatrix, StencilStorage, StepSettings, TimeStepControl};
 pub use simulation::{BodyForce, Simulation};
 pub use timing::StageTimes;
 pub use transfer::{
-    Apic, ApicFlip, Flip, MlsMpm, Pic, StressUpdate, TransferScheme, VelocityGradientAffine,
+    Apic, ApicFlip, Flip, MlsMpm, Pic, QuadraticApic, QuadraticApicFlip, StressUpdate,
+    TransferScheme, VelocityGradientAffine,
 };

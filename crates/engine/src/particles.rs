@@ -16,6 +16,9 @@ pub struct Particles<const D: usize, S, C> {
     /// the kinetic energy per unit mass of the affine motion, which the next P2G may not
     /// exceed (infinite until the first G2P: a C_p given by the user is kept).
     pub affine_moment: Vec<f64>,
+    /// Quadratic-mode coefficients Q_p ([`crate::QuadraticApic`]): empty unless the
+    /// transfer carries them, then one per particle (zero where not given).
+    pub quadratic: Vec<crate::QuadraticModes<D>>,
     /// Deformation gradients F_p.
     pub deformation: Vec<SMatrix<f64, D, D>>,
     /// Reference volumes V_p⁰.
@@ -42,6 +45,7 @@ impl<const D: usize, S: Clone, C: Copy + Default> Particles<D, S, C> {
             velocity: vec![SVector::zeros(); n],
             affine: vec![SMatrix::zeros(); n],
             affine_moment: vec![f64::INFINITY; n],
+            quadratic: Vec::new(),
             deformation: vec![SMatrix::identity(); n],
             mass: volumes.iter().map(|v| v * density).collect(),
             volume: volumes,

@@ -147,6 +147,14 @@ impl<const D: usize, S: Clone, C: Copy + Default> Particles<D, S, C> {
 
     /// Appends `other` (for scenes with several bodies or materials' worth of points).
     pub fn append(&mut self, other: Self) {
+        // Quadratic modes where either has them, zero for the particles without.
+        if !(self.quadratic.is_empty() && other.quadratic.is_empty()) {
+            let zero = [SVector::zeros(); crate::MAX_QUADRATIC_MODES];
+            self.quadratic.resize(self.position.len(), zero);
+            let mut modes = other.quadratic;
+            modes.resize(other.position.len(), zero);
+            self.quadratic.extend(modes);
+        }
         self.position.extend(other.position);
         self.velocity.extend(other.velocity);
         self.affine.extend(other.affine);

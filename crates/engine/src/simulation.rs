@@ -330,6 +330,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 + bytes(&p.velocity)
                 + bytes(&p.affine)
                 + bytes(&p.affine_moment)
+                + bytes(&p.quadratic)
                 + bytes(&p.deformation)
                 + bytes(&p.volume)
                 + bytes(&p.mass)
@@ -550,6 +551,13 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // The kernel and settings are public fields: a combination the transfer cannot
         // work with may have been set since construction.
         check_transfer(&self.transfer, &self.kernel, &self.settings)?;
+        if T::QUADRATIC {
+            // One set of modes per particle, zero for particles given without them
+            // (a no-op once sized).
+            let n = self.particles.len();
+            let zero = [SVector::zeros(); crate::MAX_QUADRATIC_MODES];
+            self.particles.quadratic.resize(n, zero);
+        }
         if self.totals.initial_energy.is_none() {
             let start = self.diagnostics()?;
             self.totals.initial_energy = Some(start.total_energy());

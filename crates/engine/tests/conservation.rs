@@ -7,8 +7,8 @@ use std::sync::Arc;
 use nalgebra::{SVector, Vector2};
 use umls_constitutive::{ElasticParameters, NeoHookean};
 use umls_engine::{
-    Apic, ApicFlip, Flip, MlsMpm, Particles, Pic, Simulation, StepSettings, StressUpdate,
-    TransferScheme, VelocityGradientAffine,
+    Apic, ApicFlip, Flip, MlsMpm, Particles, Pic, QuadraticApic, QuadraticApicFlip, Simulation,
+    StepSettings, StressUpdate, TransferScheme, VelocityGradientAffine,
 };
 use umls_kernels::{BSplineOrder, LinearFeKernel, Umls2};
 use umls_mesh::generate::{Diagonal, Lattice};
@@ -73,6 +73,8 @@ macro_rules! every_transfer {
             check($kernel, Apic, update);
             check($kernel, ApicFlip { alpha: 0.95 }, update);
             check($kernel, VelocityGradientAffine, update);
+            check($kernel, QuadraticApic, update);
+            check($kernel, QuadraticApicFlip { alpha: 0.95 }, update);
         }
     };
 }

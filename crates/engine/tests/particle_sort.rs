@@ -8,7 +8,8 @@ use std::sync::Arc;
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use umls_constitutive::NeoHookean;
 use umls_engine::{
-    Apic, EngineError, FittedClamp, Flip, MlsMpm, Simulation, StepSettings, TransferScheme,
+    Apic, EngineError, FittedClamp, Flip, MlsMpm, QuadraticApic, Simulation, StepSettings,
+    TransferScheme,
 };
 use umls_kernels::{BSplineKernel, BSplineOrder, Umls2};
 use umls_mesh::SimplexMesh;
@@ -164,6 +165,18 @@ fn sorted_particles_give_the_unsorted_bits() {
         9,
     );
     assert!(moved > 5000, "umls: the sorts moved only {moved} particles");
+    // The quadratic modes are particle state the sorts must carry along.
+    let moved = assert_sorting_changes_no_bit(
+        "umls, quadratic APIC",
+        Umls2::new(triangles(40)),
+        QuadraticApic,
+        0.004,
+        9,
+    );
+    assert!(
+        moved > 5000,
+        "umls, quadratic APIC: the sorts moved only {moved} particles"
+    );
 }
 
 /// A fitted clamp names its particles by slot: the sort renumbers it, so it holds the

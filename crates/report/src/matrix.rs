@@ -15,7 +15,7 @@ use serde::Deserialize;
 
 use crate::error::{ReportError, Result};
 
-/// The built-in matrices: `quick` (coarse levels, 571 runs, about 25 minutes on 2 cores)
+/// The built-in matrices: `quick` (coarse levels, 615 runs, about 25 minutes on 2 cores)
 /// and `full`.
 pub const BUILTIN: [(&str, &str); 2] = [
     ("quick", include_str!("../matrices/quick.toml")),
@@ -280,17 +280,18 @@ impl Matrix {
     }
 }
 
-/// The scene edits of a transfer name: `pic`, `apic`, `mls-mpm`, `flip:ALPHA` and
-/// `apic-flip:ALPHA` (`flip` and `apic-flip` alone have α = 1).
+/// The scene edits of a transfer name: `pic`, `apic`, `quadratic-apic`, `mls-mpm`,
+/// `flip:ALPHA`, `apic-flip:ALPHA` and `quadratic-apic-flip:ALPHA` (the FLIP blends alone
+/// have α = 1).
 pub fn transfer_edits(name: &str) -> Option<Vec<String>> {
     let (kind, alpha) = match name.split_once(':') {
-        None if name == "pic" || name == "apic" || name == "mls-mpm" => {
+        None if ["pic", "apic", "quadratic-apic", "mls-mpm"].contains(&name) => {
             return Some(vec![format!("transfer.kind={name}")]);
         }
         None => (name, "1.0"),
         Some(pair) => pair,
     };
-    if kind != "flip" && kind != "apic-flip" {
+    if !["flip", "apic-flip", "quadratic-apic-flip"].contains(&kind) {
         return None;
     }
     let a: f64 = alpha.parse().ok()?;
@@ -340,6 +341,11 @@ mod tests {
                 "transfer.kind=apic-flip transfer.alpha=0.95",
             ),
             ("apic-flip", "transfer.kind=apic-flip transfer.alpha=1.0"),
+            ("quadratic-apic", "transfer.kind=quadratic-apic"),
+            (
+                "quadratic-apic-flip:0.99",
+                "transfer.kind=quadratic-apic-flip transfer.alpha=0.99",
+            ),
         ] {
             assert_eq!(
                 transfer_edits(name).map(|e| e.join(" ")).as_deref(),

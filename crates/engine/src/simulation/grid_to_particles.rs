@@ -12,6 +12,7 @@ use super::tensor_rows::{gather_rows, row_width};
 use crate::boundary::Boundary;
 use crate::error::EngineError;
 use crate::parallel::lowest_failure;
+use crate::quadratic_modes::{ModeSums, QuadraticModes};
 use crate::stencils::{EntrySink, Stencils};
 use crate::transfer::{StressUpdate, TransferScheme};
 
@@ -44,6 +45,9 @@ struct GatherSums<'a, const D: usize, T> {
     grad_v: SMatrix<f64, D, D>,
     b: SMatrix<f64, D, D>,
     d: SMatrix<f64, D, D>,
+    /// The quadratic modes' sums (`None` unless the transfer has them, so that the other
+    /// transfers do not carry them through the stencil's loop).
+    modes: Option<ModeSums<D>>,
     transfer: std::marker::PhantomData<T>,
 }
 
@@ -66,6 +70,11 @@ impl<const D: usize, T: TransferScheme> EntrySink<D> for GatherSums<'_, D, T> {
             if T::USES_MOMENTS {
                 self.b += v * r.transpose() * n;
             }
+            if T::QUADRATIC {
+                if let Some(modes) = &mut self.modes {
+                    modes.add(n, &v, r);
+                }
+            }
         }
     }
 }
@@ -85,6 +94,7 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
     x: SVector<f64, D>,
     old: &SVector<f64, D>,
     dt: f64,
+    modes_out: Option<&mut QuadraticModes<D>>,
 ) -> Result<ParticleUpdate<D>, (usize, KernelError)> {
     let moment_scale = kernel.constant_second_moment();
     let offsets = T::AFFINE && (T::USES_MOMENTS || moment_scale.is_none());
@@ -102,14 +112,16 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
             (None, Some(d)) => *d,
             (None, None) => SMatrix::zeros(),
         },
+        modes: T::QUADRATIC.then(ModeSums::default),
         transfer: std::marker::PhantomData,
     };
     // A tensor-product stencil that is not stored is summed row by row, where D_p is
     // constant or unused. Stored entries get sums of their own, which no kernel call
     // takes: they stay in registers (through `visit`, whose other modes pass the sink
     // to the kernel, they were reloaded from memory at every entry).
-    let tensor_width = row_width(kernel)
-        .filter(|_| stencils.recomputed() && (moment_scale.is_some() || !T::AFFINE));
+    let tensor_width = row_width(kernel).filter(|_| {
+        stencils.recomputed() && (moment_scale.is_some() || !T::AFFINE) && !T::QUADRATIC
+    });
     let sums = if let Some(width) = tensor_width {
         let (pic, flip, grad_v, b) = match width {
             3 => gather_rows::<D, 3, T>(
@@ -145,8 +157,14 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
         grad_v,
         b,
         d,
+        modes,
         ..
     } = sums;
+    if T::QUADRATIC {
+        if let (Some(out), Some(modes)) = (modes_out, modes) {
+            *out = modes.fit(&pic, &b, &d);
+        }
+    }
     let affine = match moment_scale {
         Some(s) => transfer.affine_with_constant_moment(&b, s, &grad_v),
         None => transfer.affine(&b, &d, &grad_v),
@@ -211,6 +229,14 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         };
         let p = &mut self.particles;
         let (mass, volume) = (&p.mass, &p.volume);
+        // The modes' chunks where the transfer has them (sized with the particles at the
+        // step's start), `None` per chunk otherwise.
+        let chunks = p.velocity.len().div_ceil(crate::stencils::CHUNK);
+        let mode_chunks = p
+            .quadratic
+            .par_chunks_mut(crate::stencils::CHUNK)
+            .map(Some)
+            .chain(rayon::iter::repeat_n((), chunks).map(|_| None));
         let (gravity, step) = (self.settings.gravity_at(self.time), self.step);
         let body = &self.body_accelerations;
         let boundary = &self.boundary;
@@ -233,9 +259,16 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .zip(p.cache.par_chunks_mut(chunk))
             .zip(p.deformation.par_chunks_mut(chunk))
             .zip(p.state.par_chunks_mut(chunk))
+            .zip(mode_chunks)
             .enumerate()
             .map(
-                |(c, (((((((velocity, position), affine), moment), slot), cache), fs), states))| {
+                |(
+                    c,
+                    (
+                        (((((((velocity, position), affine), moment), slot), cache), fs), states),
+                        mut modes,
+                    ),
+                )| {
                     // The chunk's slices at one length, so the loop below indexes them
                     // without a bounds check per particle and array.
                     let n = velocity.len();
@@ -277,6 +310,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                             x,
                             &velocity[k],
                             dt,
+                            modes
+                                .as_deref_mut()
+                                .filter(|_| T::QUADRATIC)
+                                .map(|m| &mut m[k]),
                         )?;
                         let acceleration = body.get(i).map_or(gravity, |b| gravity + b);
                         power += mass[k] * acceleration.dot(&(velocity[k] + u.velocity)) * 0.5;

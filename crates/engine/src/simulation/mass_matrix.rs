@@ -14,7 +14,9 @@
 //!
 //! where A v = Σ_p m_p N_ip u_p(x_i) and u_p is the field the transfer makes of v at the
 //! particle: u_p(x) = Σ_j N_jp v_j for PIC and FLIP, plus C_p[v] (x − x_p) for affine
-//! transfers, with C_p[v] the transfer's own affine matrix of v (B_p D_p⁻¹ for APIC). With
+//! transfers, with C_p[v] the transfer's own affine matrix of v (B_p D_p⁻¹ for APIC), plus
+//! the quadratic modes of v for [`crate::QuadraticApic`] (which keep Σ_i N_ip u_p(x_i)
+//! = Σ_i N_ip v_i, so momentum and the fixed points below stay). With
 //! non-negative N the lumped matrix bounds A, so the iterations converge towards the
 //! projection, fastest for the smooth modes, and stopping early leaves the rough ones
 //! lumped. Properties the tests hold:
@@ -40,6 +42,7 @@ use umls_transfer::{Kernel, Stencil};
 
 use super::Simulation;
 use crate::error::EngineError;
+use crate::quadratic_modes::{ModeFrame, ModeSums};
 use crate::scatter::{NODE_CHUNK, NodalSums, Scatter};
 use crate::transfer::TransferScheme;
 
@@ -180,6 +183,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                             let mut value = SVector::<f64, D>::zeros();
                             let (mut b, mut d, mut grad_v) =
                                 (SMatrix::zeros(), SMatrix::zeros(), SMatrix::zeros());
+                            let mut mode_sums = ModeSums::<D>::default();
                             for e in 0..st.len() {
                                 let (n, v) = (st.values[e], velocity[st.nodes[e] as usize]);
                                 value += v * n;
@@ -188,6 +192,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                     b += v * r.transpose() * n;
                                     d += r * r.transpose() * n;
                                     grad_v += v * st.gradients[e].transpose();
+                                    if T::QUADRATIC {
+                                        mode_sums.add(n, &v, &r);
+                                    }
                                 }
                             }
                             let c = if !affine {
@@ -197,11 +204,29 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                             } else {
                                 transfer.affine(&b, &d, &grad_v)
                             };
+                            // The quadratic modes of v, with their frame, where the
+                            // transfer has them.
+                            let modes = (affine && T::QUADRATIC)
+                                .then(|| {
+                                    ModeFrame::of_stencil(
+                                        (0..st.len())
+                                            .map(|e| (st.values[e], st.offset(e, kernel, &x))),
+                                    )
+                                })
+                                .flatten()
+                                .map(|frame| {
+                                    let d = moment_scale.map_or(d, |s| SMatrix::identity() * s);
+                                    (frame, mode_sums.fit(&value, &b, &d))
+                                });
                             for e in 0..st.len() {
                                 let n = st.values[e];
                                 let mut u = value;
                                 if affine {
-                                    u += c * st.offset(e, kernel, &x);
+                                    let r = st.offset(e, kernel, &x);
+                                    u += c * r;
+                                    if let Some((frame, modes)) = &modes {
+                                        u += frame.velocity(modes, &r);
+                                    }
                                 }
                                 window.add_momentum::<1>(
                                     window.record(st.nodes[e] as usize),

@@ -65,6 +65,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let mut vectors = Vec::new();
         gather(&mut p.position, &order, &mut vectors);
         gather(&mut p.velocity, &order, &mut vectors);
+        if p.quadratic.len() == n {
+            gather(&mut p.quadratic, &order, &mut Vec::new());
+        }
         let mut scalars = Vec::new();
         gather(&mut p.affine_moment, &order, &mut scalars);
         gather(&mut p.volume, &order, &mut scalars);

@@ -9,6 +9,7 @@ use umls_transfer::{Kernel, Stencil};
 use super::Simulation;
 use super::tensor_rows::{ParticleLoad, row_width, scatter_rows};
 use crate::error::EngineError;
+use crate::quadratic_modes::{ModeFrame, QuadraticModes};
 use crate::scatter::Window;
 use crate::stencils::{EntrySink, correction_mean, second_moment};
 use crate::transfer::TransferScheme;
@@ -51,6 +52,9 @@ struct ScatterEntry<'w, const D: usize, T, const CORRECTED: bool, const A: usize
     /// ξ̄_p = Σ_i N_i ξ_i at the particle, which makes the corrections sum to zero over
     /// its stencil, so the internal forces still sum to zero (momentum is conserved).
     correction_mean: SVector<f64, D>,
+    /// The particle's quadratic modes and their frame at its position (`None` unless
+    /// the transfer has them and the stencil admits them).
+    modes: Option<(ModeFrame<D>, QuadraticModes<D>)>,
     transfer: std::marker::PhantomData<T>,
 }
 
@@ -71,6 +75,11 @@ impl<const D: usize, T: TransferScheme, const CORRECTED: bool, const A: usize> E
         let mut mv = self.load.velocity;
         if T::AFFINE {
             mv += self.load.affine * r;
+        }
+        if T::QUADRATIC {
+            if let Some((frame, modes)) = &self.modes {
+                mv += frame.velocity(modes, r);
+            }
         }
         let corrected;
         let gradient = if CORRECTED {
@@ -139,9 +148,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // A tensor-product stencil that is not stored is summed row by row
         // ([`scatter_rows`]), where no entry-wise correction, |N|-mass or limiter needs
         // the entries one by one.
-        let tensor_width = row_width(kernel).filter(|_| {
-            A == 0 && !CORRECTED && !(T::AFFINE && varying_moment) && stencils.recomputed()
-        });
+        // (Nor quadratic modes, whose frame P2G evaluates from the whole stencil.)
+        let entrywise = CORRECTED || (T::AFFINE && varying_moment) || T::QUADRATIC;
+        let tensor_width =
+            row_width(kernel).filter(|_| A == 0 && !entrywise && stencils.recomputed());
         // Summed row by row, the blocks' windows can be boxes of the kernel's lattice.
         let lattice = tensor_width
             .and(kernel.node_lattice())
@@ -168,6 +178,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         },
                         correction: correction.unwrap_or(&[]),
                         correction_mean: SVector::zeros(),
+                        modes: None,
                         transfer: std::marker::PhantomData::<T>,
                     };
                     let stored_moment = stencils.stored_second_moment(i);
@@ -204,7 +215,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                 scatter_rows::<D, 4, T>(&t, window, load);
                             }
                         }
-                    } else if limiter_reads || mean_reads {
+                    } else if limiter_reads || mean_reads || T::QUADRATIC {
                         // One evaluation serves the whole-stencil sums and the entries.
                         stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
                             if let Some(xi) = correction.filter(|_| mean_reads) {
@@ -215,6 +226,13 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                     limited_affine(&p.affine[i], p.affine_moment[i], || {
                                         second_moment(&st, kernel, &x)
                                     });
+                            }
+                            if T::QUADRATIC {
+                                // The modes' frame at the particle's new position.
+                                sink.modes = ModeFrame::of_stencil(
+                                    (0..st.len()).map(|e| (st.values[e], st.offset(e, kernel, &x))),
+                                )
+                                .map(|frame| (frame, p.quadratic[i]));
                             }
                             for e in 0..st.len() {
                                 let r = st.offset(e, kernel, &x);
