@@ -230,9 +230,9 @@ fn eta8_weights_bring_the_disks_within_five_points_of_quadratic_b_splines() {
 /// Quadratic APIC (the particles also carry quadratic velocity modes) keeps the
 /// curvature APIC's round trip filters, so every kernel loses far less on the disks,
 /// and the wider UMLS stencil's extra filtering goes with it: by t = 3, `umls` loses
-/// 0.326 / 0.212 at 20 / 40 cells against bspline2's 0.301 / 0.170 (APIC: 0.860 / 0.651
-/// against 0.700 / 0.471), within the 5 points at both, and less than bspline2
-/// loses with APIC (docs/umls-kernel.md, *Quadratic APIC*).
+/// 0.327 / 0.212 at 20 / 40 cells against bspline2's 0.302 / 0.171 (APIC: 0.860 / 0.651
+/// against 0.700 / 0.471), within the 5 points at both, and less than half what
+/// bspline2 loses with APIC (docs/umls-kernel.md, *Quadratic APIC*).
 #[test]
 fn quadratic_apic_brings_umls_within_five_points_of_quadratic_b_splines_on_the_disks() {
     for refine in [1.0, 2.0] {

@@ -107,6 +107,19 @@ impl<const D: usize> ModeFrame<D> {
         Self::new(&d, &third)
     }
 
+    /// The modes' kinetic energy per unit mass on a stencil of (N_i, r_i) pairs,
+    /// Σ_i N_i |Σ_k Q_k q_k(r_i)|² = tr(Q G Qᵀ): what P2G's limiter compares with the
+    /// energy the modes had where G2P fitted them.
+    pub(crate) fn energy(
+        &self,
+        modes: &QuadraticModes<D>,
+        entries: impl Iterator<Item = (f64, SVector<f64, D>)>,
+    ) -> f64 {
+        entries
+            .map(|(n, r)| n * self.velocity(modes, &r).norm_squared())
+            .sum()
+    }
+
     /// The modes' velocity at offset `r`: Σ_k Q_k q_k(r).
     #[inline(always)]
     pub(crate) fn velocity(
@@ -173,23 +186,24 @@ impl<const D: usize> ModeSums<D> {
         }
     }
 
-    /// The modes' coefficients Q_p, given the same pass's PIC value `pic` = Σ N ṽ, APIC's
-    /// B = Σ N ṽ rᵀ and the second moment `d` = Σ N r rᵀ (zero where D is not positive
-    /// definite, where APIC falls back too).
+    /// The modes' coefficients Q_p and their energy tr(Q G Qᵀ) (with the unridged G),
+    /// given the same pass's PIC value `pic` = Σ N ṽ, APIC's B = Σ N ṽ rᵀ and the second
+    /// moment `d` = Σ N r rᵀ (no modes where D is not positive definite, where APIC
+    /// falls back too).
     pub(crate) fn fit(
         &self,
         pic: &SVector<f64, D>,
         b: &SMatrix<f64, D, D>,
         d: &SMatrix<f64, D, D>,
-    ) -> QuadraticModes<D> {
+    ) -> (QuadraticModes<D>, f64) {
         let mut modes = [SVector::zeros(); MAX_QUADRATIC_MODES];
         let Some(frame) = ModeFrame::new(d, &self.third) else {
-            return modes;
+            return (modes, 0.0);
         };
         let q = mode_count(D);
         let scale = d.trace() / D as f64;
-        // G_kl = Σ N q_k q_l = Σ N m_k m_l − M_k M_l − T_k · w_l (q_k ⊥ 1, r), ridged;
-        // the unused modes' rows are the identity's.
+        // G_kl = Σ N q_k q_l = Σ N m_k m_l − M_k M_l − T_k · w_l (q_k ⊥ 1, r); the unused
+        // modes' rows are the identity's.
         let mut gram = SMatrix::<f64, MAX_QUADRATIC_MODES, MAX_QUADRATIC_MODES>::identity();
         for k in 0..q {
             for l in k..q {
@@ -199,10 +213,13 @@ impl<const D: usize> ModeSums<D> {
                 gram[(k, l)] = g;
                 gram[(l, k)] = g;
             }
-            gram[(k, k)] += QUADRATIC_RIDGE * scale * scale;
         }
-        let Some(cholesky) = gram.cholesky() else {
-            return modes;
+        let mut ridged = gram;
+        for k in 0..q {
+            ridged[(k, k)] += QUADRATIC_RIDGE * scale * scale;
+        }
+        let Some(cholesky) = ridged.cholesky() else {
+            return (modes, 0.0);
         };
         // Right-hand sides Σ N ṽ q_k = Σ N ṽ m_k − M_k Σ N ṽ − B w_k, one per component.
         let mut rhs = SMatrix::<f64, MAX_QUADRATIC_MODES, D>::zeros();
@@ -214,10 +231,17 @@ impl<const D: usize> ModeSums<D> {
         for (k, mode) in modes.iter_mut().enumerate().take(q) {
             *mode = solved.row(k).transpose();
         }
-        if modes.iter().all(|m| m.iter().all(|c| c.is_finite())) {
-            modes
+        let energy: f64 = (0..q)
+            .map(|k| {
+                (0..q)
+                    .map(|l| modes[k].dot(&modes[l]) * gram[(k, l)])
+                    .sum::<f64>()
+            })
+            .sum();
+        if energy.is_finite() && modes.iter().all(|m| m.iter().all(|c| c.is_finite())) {
+            (modes, energy)
         } else {
-            [SVector::zeros(); MAX_QUADRATIC_MODES]
+            ([SVector::zeros(); MAX_QUADRATIC_MODES], 0.0)
         }
     }
 }
@@ -282,8 +306,14 @@ mod tests {
             b += v * r.transpose() * *n;
             d += r * r.transpose() * *n;
         }
-        let modes = sums.fit(&pic, &b, &d);
+        let (modes, energy) = sums.fit(&pic, &b, &d);
         let frame = ModeFrame::of_stencil(stencil.iter().copied()).unwrap();
+        // The fit's energy is the modes' field's Σ N |Σ Q q|² on the same stencil.
+        let direct = frame.energy(&modes, stencil.iter().copied());
+        assert!(
+            (energy - direct).abs() < 1e-12 * direct,
+            "{energy} against {direct}"
+        );
         let c = b * d.try_inverse().unwrap();
         // The fitted field v_p + C r + Σ Q q against the field at every node; the ridge
         // (10⁻² of the modes' scale) shrinks the quadratic part by about as much.
@@ -315,8 +345,8 @@ mod tests {
             .map(|(n, r)| r * r.transpose() * *n)
             .sum::<SMatrix<f64, 3, 3>>();
         // D is singular here (no spread in y, z): no frame, no modes.
-        let modes = sums.fit(&Vector3::new(1.0, 2.0, 3.0), &SMatrix::zeros(), &d);
-        assert!(modes.iter().all(|m| *m == Vector3::zeros()));
+        let (modes, energy) = sums.fit(&Vector3::new(1.0, 2.0, 3.0), &SMatrix::zeros(), &d);
+        assert!(modes.iter().all(|m| *m == Vector3::zeros()) && energy == 0.0);
         assert_eq!(mode_count(3), 6);
         assert_eq!(
             monomials(&Vector3::new(1.0, 2.0, 3.0)),

@@ -173,6 +173,39 @@ mod tests {
     use nalgebra::Vector2;
 
     #[test]
+    fn appending_pads_the_quadratic_modes_of_the_side_without_them() {
+        let at = |n: usize| {
+            Particles::<2, (), ()>::at_rest(vec![Vector2::zeros(); n], vec![1.0; n], 1.0, ())
+        };
+        let mut with_modes = at(3);
+        with_modes.quadratic = vec![[Vector2::new(1.0, 2.0); crate::MAX_QUADRATIC_MODES]; 3];
+        let mut joined = at(2);
+        joined.append(with_modes.clone());
+        assert_eq!(joined.quadratic.len(), 5);
+        assert!(
+            joined.quadratic[..2]
+                .iter()
+                .flatten()
+                .all(|c| *c == Vector2::zeros())
+        );
+        assert_eq!(joined.quadratic[2..], with_modes.quadratic[..]);
+        with_modes.append(at(2));
+        assert_eq!(with_modes.quadratic.len(), 5);
+        assert!(
+            with_modes.quadratic[3..]
+                .iter()
+                .flatten()
+                .all(|c| *c == Vector2::zeros())
+        );
+        let mut plain = at(2);
+        plain.append(at(2));
+        assert!(
+            plain.quadratic.is_empty(),
+            "no modes where neither side has them"
+        );
+    }
+
+    #[test]
     fn combined_regions_are_the_set_operations() {
         let ball = |r: f64| Region::Ball {
             centre: Vector2::zeros(),

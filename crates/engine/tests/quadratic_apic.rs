@@ -67,8 +67,9 @@ fn loss_per_step<K: Kernel<2> + Clone, T: TransferScheme>(kernel: &K, transfer: 
 
 /// Without stress the step is the transfers' round trip alone. APIC keeps affine fields
 /// and filters the curvature of this one every step; the quadratic modes keep it up to
-/// the fit's ridge and the block's free edges. Measured: `umls` 1.18·10⁻⁴ → 8.2·10⁻⁶ per
-/// step (0.07×), bspline2 5.5·10⁻⁵ → 7.0·10⁻⁷ (0.013×), bspline3 1.3·10⁻⁵ → 4.7·10⁻⁶.
+/// the fit's ridge and the block's free edges. Measured: `umls` 1.22·10⁻⁴ → 8.7·10⁻⁶ per
+/// step (0.07×), bspline2 5.7·10⁻⁵ → 7.0·10⁻⁷ (0.012×), bspline3 9.4·10⁻⁵ → 4.8·10⁻⁶
+/// (0.05×).
 #[test]
 fn quadratic_modes_keep_what_the_apic_round_trip_filters() {
     let cases: [(&str, f64); 3] = [("umls", 0.1), ("bspline2", 0.03), ("bspline3", 0.1)];

@@ -160,9 +160,11 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
         modes,
         ..
     } = sums;
+    // The modes' energy joins C_p's in the moment P2G's limiter reads.
+    let mut mode_energy = 0.0;
     if T::QUADRATIC {
         if let (Some(out), Some(modes)) = (modes_out, modes) {
-            *out = modes.fit(&pic, &b, &d);
+            (*out, mode_energy) = modes.fit(&pic, &b, &d);
         }
     }
     let affine = match moment_scale {
@@ -173,12 +175,14 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
         velocity: transfer.velocity(old, &pic, &flip),
         position: x + pic * dt,
         // tr(C D Cᵀ), which P2G's limiter compares with at the next position; with
-        // D = s I it is s |C|² (and P2G reads it only where D varies).
-        affine_moment: match (T::AFFINE, moment_scale) {
-            (false, _) => 0.0,
-            (true, Some(s)) => s * affine.norm_squared(),
-            (true, None) => (affine * d * affine.transpose()).trace(),
-        },
+        // D = s I it is s |C|² (and P2G reads it only where D varies or quadratic modes
+        // add their energy).
+        affine_moment: mode_energy
+            + match (T::AFFINE, moment_scale) {
+                (false, _) => 0.0,
+                (true, Some(s)) => s * affine.norm_squared(),
+                (true, None) => (affine * d * affine.transpose()).trace(),
+            },
         affine,
         // MLS-MPM takes C_p as the velocity gradient (its ∇N is D⁻¹ N r).
         velocity_gradient: if T::FUSED_FORCE { affine } else { grad_v },

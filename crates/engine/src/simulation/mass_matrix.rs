@@ -216,7 +216,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                 .flatten()
                                 .map(|frame| {
                                     let d = moment_scale.map_or(d, |s| SMatrix::identity() * s);
-                                    (frame, mode_sums.fit(&value, &b, &d))
+                                    (frame, mode_sums.fit(&value, &b, &d).0)
                                 });
                             for e in 0..st.len() {
                                 let n = st.values[e];

@@ -38,6 +38,22 @@ fn limited_affine<const D: usize>(
     }
 }
 
+/// The factor that brings the energy `now` of a particle's affine and quadratic fields
+/// at its new position down to `moment`, what they had where G2P made them: the
+/// quadratic modes' G changes as a particle moves (for B-splines too), as D does for
+/// mesh kernels, and narrow stencils turned that into an energy source ([`limited_affine`]
+/// for C_p alone). 0 where the moment is 0, 1 where it is not a positive number.
+fn field_limit(now: f64, moment: f64) -> f64 {
+    if !moment.is_finite() || moment <= 0.0 {
+        return if moment == 0.0 { 0.0 } else { 1.0 };
+    }
+    if now > moment * (1.0 + 1e-9) {
+        (moment / now).sqrt()
+    } else {
+        1.0
+    }
+}
+
 /// One particle's contributions to the nodes of its stencil. `CORRECTED` is whether the
 /// kernel has an integration correction: a constant, so that the kernels without one
 /// (B-splines, whose visits are inlined here) keep an entry free of its branch. `A` is
@@ -184,7 +200,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     let stored_moment = stencils.stored_second_moment(i);
                     // The limiter and the correction's ξ̄_p read the whole stencil before
                     // the first entry, unless the stencil stage stored what they need.
-                    let limiter_reads = T::AFFINE && varying_moment && stored_moment.is_none();
+                    // (Quadratic modes have a limiter of their own, below.)
+                    let limiter_reads =
+                        T::AFFINE && varying_moment && stored_moment.is_none() && !T::QUADRATIC;
                     let stored_mean = correction.and(stencils.stored_correction_mean(i));
                     let mean_reads = correction.is_some() && stored_mean.is_none();
                     if let Some(mean) = stored_mean {
@@ -228,11 +246,23 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                     });
                             }
                             if T::QUADRATIC {
-                                // The modes' frame at the particle's new position.
-                                sink.modes = ModeFrame::of_stencil(
-                                    (0..st.len()).map(|e| (st.values[e], st.offset(e, kernel, &x))),
-                                )
-                                .map(|frame| (frame, p.quadratic[i]));
+                                // The modes' frame at the particle's new position, and one
+                                // limit for C_p and the modes together.
+                                let entries = || {
+                                    (0..st.len()).map(|e| (st.values[e], st.offset(e, kernel, &x)))
+                                };
+                                if let Some(frame) = ModeFrame::of_stencil(entries()) {
+                                    let (c, modes) = (p.affine[i], p.quadratic[i]);
+                                    let d = match kernel.constant_second_moment() {
+                                        Some(s) => SMatrix::identity() * s,
+                                        None => second_moment(&st, kernel, &x),
+                                    };
+                                    let now = (c * d * c.transpose()).trace()
+                                        + frame.energy(&modes, entries());
+                                    let limit = field_limit(now, p.affine_moment[i]);
+                                    sink.load.affine = c * limit;
+                                    sink.modes = Some((frame, modes.map(|m| m * limit)));
+                                }
                             }
                             for e in 0..st.len() {
                                 let r = st.offset(e, kernel, &x);
