@@ -225,6 +225,21 @@ macro_rules! apic_affine {
     };
 }
 
+/// [`Flip`]'s velocity update with the scheme's `alpha`, in the impl of an affine scheme
+/// blended with FLIP.
+macro_rules! flip_velocity {
+    () => {
+        fn velocity<const D: usize>(
+            &self,
+            old: &SVector<f64, D>,
+            pic: &SVector<f64, D>,
+            flip_increment: &SVector<f64, D>,
+        ) -> SVector<f64, D> {
+            Flip { alpha: self.alpha }.velocity(old, pic, flip_increment)
+        }
+    };
+}
+
 impl TransferScheme for MlsMpm {
     const AFFINE: bool = true;
     const USES_MOMENTS: bool = true;
@@ -242,14 +257,7 @@ impl TransferScheme for ApicFlip {
     fn name(&self) -> &'static str {
         "APIC-FLIP"
     }
-    fn velocity<const D: usize>(
-        &self,
-        old: &SVector<f64, D>,
-        pic: &SVector<f64, D>,
-        flip_increment: &SVector<f64, D>,
-    ) -> SVector<f64, D> {
-        Flip { alpha: self.alpha }.velocity(old, pic, flip_increment)
-    }
+    flip_velocity!();
     apic_affine!();
 }
 
@@ -271,14 +279,7 @@ impl TransferScheme for QuadraticApicFlip {
     fn name(&self) -> &'static str {
         "quadratic APIC-FLIP"
     }
-    fn velocity<const D: usize>(
-        &self,
-        old: &SVector<f64, D>,
-        pic: &SVector<f64, D>,
-        flip_increment: &SVector<f64, D>,
-    ) -> SVector<f64, D> {
-        Flip { alpha: self.alpha }.velocity(old, pic, flip_increment)
-    }
+    flip_velocity!();
     apic_affine!();
 }
 
