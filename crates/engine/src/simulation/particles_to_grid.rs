@@ -41,8 +41,9 @@ fn limited_affine<const D: usize>(
 /// The factor that brings the energy `now` of a particle's affine and quadratic fields
 /// at its new position down to `moment`, what they had where G2P made them: the
 /// quadratic modes' G changes as a particle moves (for B-splines too), as D does for
-/// mesh kernels, and narrow stencils turned that into an energy source ([`limited_affine`]
-/// for C_p alone). 0 where the moment is 0, 1 where it is not a positive number.
+/// mesh kernels, so without a bound their energy could grow with the motion alone
+/// ([`limited_affine`] for C_p alone). 0 where the moment is 0, 1 where it is not a
+/// positive number.
 fn field_limit(now: f64, moment: f64) -> f64 {
     if !moment.is_finite() || moment <= 0.0 {
         return if moment == 0.0 { 0.0 } else { 1.0 };
