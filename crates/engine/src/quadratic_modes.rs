@@ -91,10 +91,12 @@ impl<const D: usize> ModeFrame<D> {
             .then_some(frame)
     }
 
-    /// The frame of a whole stencil: (N_i, r_i) pairs.
+    /// The frame of a whole stencil of (N_i, r_i) pairs, with the stencil's second
+    /// moment D = Σ N r rᵀ it was built from (summed in entry order, the bits of
+    /// `stencils::second_moment`, so a caller needs no second pass for it).
     pub(crate) fn of_stencil(
         entries: impl Iterator<Item = (f64, SVector<f64, D>)>,
-    ) -> Option<Self> {
+    ) -> Option<(Self, SMatrix<f64, D, D>)> {
         let mut d = SMatrix::<f64, D, D>::zeros();
         let mut third = [SVector::<f64, D>::zeros(); MAX_QUADRATIC_MODES];
         for (n, r) in entries {
@@ -104,7 +106,7 @@ impl<const D: usize> ModeFrame<D> {
                 third[k] += r * (m[k] * n);
             }
         }
-        Self::new(&d, &third)
+        Self::new(&d, &third).map(|frame| (frame, d))
     }
 
     /// The modes' kinetic energy per unit mass on a stencil of (N_i, r_i) pairs,
@@ -184,6 +186,13 @@ impl<const D: usize> ModeSums<D> {
                 self.fourth[(k, l)] += nm * ml;
             }
         }
+    }
+
+    /// The modes' frame on the stencil these sums were gathered from, given its second
+    /// moment `d` (the bits of [`ModeFrame::of_stencil`] when `d` was summed in the same
+    /// pass).
+    pub(crate) fn frame(&self, d: &SMatrix<f64, D, D>) -> Option<ModeFrame<D>> {
+        ModeFrame::new(d, &self.third)
     }
 
     /// The modes' coefficients Q_p and their energy tr(Q G Qᵀ) (with the unridged G),
@@ -272,7 +281,7 @@ mod tests {
     #[test]
     fn the_modes_are_orthogonal_to_the_constant_and_the_offset() {
         let stencil = weighted_offsets();
-        let frame = ModeFrame::of_stencil(stencil.iter().copied()).unwrap();
+        let (frame, _) = ModeFrame::of_stencil(stencil.iter().copied()).unwrap();
         for k in 0..3 {
             let mut unit = [SVector::zeros(); MAX_QUADRATIC_MODES];
             unit[k] = Vector2::new(1.0, 0.0);
@@ -307,7 +316,7 @@ mod tests {
             d += r * r.transpose() * *n;
         }
         let (modes, energy) = sums.fit(&pic, &b, &d);
-        let frame = ModeFrame::of_stencil(stencil.iter().copied()).unwrap();
+        let (frame, _) = ModeFrame::of_stencil(stencil.iter().copied()).unwrap();
         // The fit's energy is the modes' field's Σ N |Σ Q q|² on the same stencil.
         let direct = frame.energy(&modes, stencil.iter().copied());
         assert!(

@@ -42,7 +42,7 @@ use umls_transfer::{Kernel, Stencil};
 
 use super::Simulation;
 use crate::error::EngineError;
-use crate::quadratic_modes::{ModeFrame, ModeSums};
+use crate::quadratic_modes::ModeSums;
 use crate::scatter::{NODE_CHUNK, NodalSums, Scatter};
 use crate::transfer::TransferScheme;
 
@@ -183,7 +183,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                             let mut value = SVector::<f64, D>::zeros();
                             let (mut b, mut d, mut grad_v) =
                                 (SMatrix::zeros(), SMatrix::zeros(), SMatrix::zeros());
-                            let mut mode_sums = ModeSums::<D>::default();
+                            let mut mode_sums =
+                                (affine && T::QUADRATIC).then(ModeSums::<D>::default);
                             for e in 0..st.len() {
                                 let (n, v) = (st.values[e], velocity[st.nodes[e] as usize]);
                                 value += v * n;
@@ -192,8 +193,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                     b += v * r.transpose() * n;
                                     d += r * r.transpose() * n;
                                     grad_v += v * st.gradients[e].transpose();
-                                    if T::QUADRATIC {
-                                        mode_sums.add(n, &v, &r);
+                                    if let Some(sums) = &mut mode_sums {
+                                        sums.add(n, &v, &r);
                                     }
                                 }
                             }
@@ -206,18 +207,13 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                             };
                             // The quadratic modes of v, with their frame, where the
                             // transfer has them.
-                            let modes = (affine && T::QUADRATIC)
-                                .then(|| {
-                                    ModeFrame::of_stencil(
-                                        (0..st.len())
-                                            .map(|e| (st.values[e], st.offset(e, kernel, &x))),
-                                    )
-                                })
-                                .flatten()
-                                .map(|frame| {
-                                    let d = moment_scale.map_or(d, |s| SMatrix::identity() * s);
-                                    (frame, mode_sums.fit(&value, &b, &d).0)
-                                });
+                            // (The frame from the summed D, as P2G builds it; the fit
+                            // with the kernel's D, as G2P makes it.)
+                            let modes = mode_sums.as_ref().and_then(|sums| {
+                                let frame = sums.frame(&d)?;
+                                let d = moment_scale.map_or(d, |s| SMatrix::identity() * s);
+                                Some((frame, sums.fit(&value, &b, &d).0))
+                            });
                             for e in 0..st.len() {
                                 let n = st.values[e];
                                 let mut u = value;

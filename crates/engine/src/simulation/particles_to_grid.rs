@@ -252,11 +252,11 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                 let entries = || {
                                     (0..st.len()).map(|e| (st.values[e], st.offset(e, kernel, &x)))
                                 };
-                                if let Some(frame) = ModeFrame::of_stencil(entries()) {
+                                if let Some((frame, summed)) = ModeFrame::of_stencil(entries()) {
                                     let (c, modes) = (p.affine[i], p.quadratic[i]);
                                     let d = match kernel.constant_second_moment() {
                                         Some(s) => SMatrix::identity() * s,
-                                        None => second_moment(&st, kernel, &x),
+                                        None => summed,
                                     };
                                     let now = (c * d * c.transpose()).trace()
                                         + frame.energy(&modes, entries());
