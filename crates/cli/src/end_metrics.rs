@@ -1,6 +1,7 @@
 //! Metrics of a run's end state that the scene asks for: the largest value of each
-//! material state scalar, a front's advance, the probes' final displacements, and the
-//! hydrostatic column's comparison with its closed form.
+//! material state scalar, each body's bulk motion where there are several, a front's
+//! advance, the probes' final displacements, and the hydrostatic column's comparison
+//! with its closed form.
 
 use nalgebra::SVector;
 use serde_json::{Map, Value, json};
@@ -13,7 +14,8 @@ use crate::schema::ProfileSpec;
 use crate::setup::{self, Setup};
 
 /// The end-state metrics of `sim`; `initial` are the particles' initial (world)
-/// positions. The column's stresses are not evaluated after a failure.
+/// positions, `initial_energy` the run's initial mechanical energy. The column's
+/// stresses and the bodies' motion are not evaluated after a failure.
 pub(crate) fn end_state<const D: usize>(
     scene: &Scene,
     setup: &Setup<D>,
@@ -21,10 +23,19 @@ pub(crate) fn end_state<const D: usize>(
     initial: &[SVector<f64, D>],
     probes: &Probes,
     failed: bool,
+    initial_energy: f64,
 ) -> Result<Map<String, Value>> {
     let mut metrics = Map::new();
     for (name, max) in sim.state_scalar_maxima() {
         metrics.insert(format!("max_{name}"), json!(max));
+    }
+    if scene.spec.bodies.len() > 1 && !failed {
+        metrics.extend(bodies_in_bulk(
+            setup,
+            sim,
+            scene.spec.bodies.len(),
+            initial_energy,
+        ));
     }
     if let Some(direction) = &scene.spec.output.front {
         let d: SVector<f64, D> = setup::vector(scene, "output.front", direction)?;
@@ -65,6 +76,45 @@ pub(crate) fn end_state<const D: usize>(
         metrics.extend(column.metrics(&setup.frame, initial, sim.positions(), &stresses));
     }
     Ok(metrics)
+}
+
+/// Each body's bulk motion at the end, for scenes of several bodies: `body_velocities`,
+/// the centre-of-mass velocity of each body (scene frame, in `[[bodies]]` order), and
+/// `bulk_kinetic_fraction`, the kinetic energy of those bulk motions, Σ_b ½ M_b |V_b|²,
+/// over the initial energy (absent when that is zero). After a collision of bodies that
+/// started in rigid motion it is the share of the energy that left as bulk motion (for
+/// two equal bodies meeting head-on, the restitution squared); the rest of what the
+/// run's energy keeps is inside the bodies (ringing, strain).
+fn bodies_in_bulk<const D: usize>(
+    setup: &Setup<D>,
+    sim: &dyn Run<D>,
+    bodies: usize,
+    initial_energy: f64,
+) -> Map<String, Value> {
+    let mut mass = vec![0.0; bodies];
+    let mut momentum = vec![SVector::<f64, D>::zeros(); bodies];
+    for (slot, (m, v)) in sim.masses().iter().zip(sim.velocities()).enumerate() {
+        let body = setup.seeds.body[sim.particle_id(slot)] as usize;
+        mass[body] += m;
+        momentum[body] += v * *m;
+    }
+    let velocities: Vec<SVector<f64, D>> =
+        momentum.iter().zip(&mass).map(|(p, m)| p / *m).collect();
+    let bulk: f64 = velocities
+        .iter()
+        .zip(&mass)
+        .map(|(v, m)| 0.5 * m * v.norm_squared())
+        .sum();
+    let mut metrics = Map::new();
+    let listed: Vec<Vec<f64>> = velocities
+        .iter()
+        .map(|v| setup.frame.vector_to_scene(v).iter().copied().collect())
+        .collect();
+    metrics.insert("body_velocities".into(), json!(listed));
+    if initial_energy > 0.0 {
+        metrics.insert("bulk_kinetic_fraction".into(), json!(bulk / initial_energy));
+    }
+    metrics
 }
 
 /// The highest particle (along `up`) in each bin along `along`, scene frame; `null` for

@@ -101,6 +101,11 @@ impl<const D: usize> SceneFrame<D> {
         self.rotation * v
     }
 
+    /// A world vector in the scene frame: Rᵀ v.
+    pub fn vector_to_scene(&self, v: &SVector<f64, D>) -> SVector<f64, D> {
+        self.rotation.transpose() * v
+    }
+
     /// A scene-frame tensor (an affine velocity matrix) in the world: R t Rᵀ.
     pub fn tensor_to_world(&self, t: &SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
         self.rotation * t * self.rotation.transpose()

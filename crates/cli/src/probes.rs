@@ -91,7 +91,7 @@ impl Probes {
         positions: &[SVector<f64, D>],
     ) -> SVector<f64, D> {
         let i = self.slots[k];
-        frame.rotation.transpose() * (positions[i] - initial[i])
+        frame.vector_to_scene(&(positions[i] - initial[i]))
     }
 }
 

@@ -466,10 +466,12 @@ fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
     kernel: K,
     table: MaterialTable<P>,
 ) -> Result<RunReport> {
-    // Three transfer types instead of five keep down the simulations this crate compiles:
-    // PIC is FLIP with α = 0 (v = 0·(v + Δv) + 1·v_PIC, the same numbers), and the two
-    // affine schemes share one type. APIC-FLIP has its own, so that APIC does not read
-    // the old grid velocities it has no use for.
+    // Five transfer types for the eight kinds keep down the simulations this crate
+    // compiles: PIC is FLIP with α = 0 (v = 0·(v + Δv) + 1·v_PIC, the same numbers), the
+    // two affine schemes share one type, and quadratic APIC is its FLIP blend at α = 0
+    // (the same bits, tested in the engine). APIC-FLIP has its own type, so that APIC
+    // does not read the old grid velocities it has no use for; MLS-MPM has its own, as
+    // its force is folded into the momentum.
     let t = &ctx.scene.spec.transfer;
     if !(0.0..=1.0).contains(&t.alpha) {
         return Err(ctx
@@ -632,6 +634,7 @@ pub(crate) trait Run<const D: usize> {
     fn boundary(&mut self) -> &mut Boundary<D>;
     fn positions(&self) -> &[SVector<f64, D>];
     fn velocities(&self) -> &[SVector<f64, D>];
+    fn masses(&self) -> &[f64];
     /// The scene's index of the particle stored in `slot` (sorting moves particles).
     fn particle_id(&self, slot: usize) -> usize;
     /// How many times the particles have been sorted.
@@ -710,6 +713,9 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
     }
     fn velocities(&self) -> &[SVector<f64, D>] {
         &self.particles().velocity
+    }
+    fn masses(&self) -> &[f64] {
+        &self.particles().mass
     }
     fn particle_id(&self, slot: usize) -> usize {
         Simulation::particle_id(self, slot)
@@ -1091,6 +1097,7 @@ fn drive<const D: usize>(ctx: &Context<'_, D>, sim: &mut dyn Run<D>) -> Result<R
         &reference_positions,
         &probes,
         failure.is_some(),
+        e0,
     )?);
     if let Some((wall, _, _)) = &wall_pressure {
         metrics.extend(wall.metrics());

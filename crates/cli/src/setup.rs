@@ -49,6 +49,8 @@ pub struct Seeds<const D: usize> {
     pub affine: Vec<SMatrix<f64, D, D>>,
     /// Material index.
     pub material: Vec<u16>,
+    /// The body (index into `[[bodies]]`) that seeded each particle.
+    pub body: Vec<u32>,
 }
 
 /// A boundary condition resolved to geometry.
@@ -654,6 +656,7 @@ fn seed_body<const D: usize>(
             _ => SMatrix::zeros(),
         });
         seeds.material.push(material);
+        seeds.body.push(index as u32);
     }
     if seeds.position.len() == before {
         return Err(scene.value_error(key("region"), "the region holds no particle"));
