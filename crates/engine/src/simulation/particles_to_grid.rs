@@ -30,12 +30,7 @@ fn limited_affine<const D: usize>(
         return if moment == 0.0 { SMatrix::zeros() } else { *c };
     }
     let d = d();
-    let now = (c * d * c.transpose()).trace();
-    if now > moment * (1.0 + 1e-9) {
-        c * (moment / now).sqrt()
-    } else {
-        *c
-    }
+    c * field_limit((c * d * c.transpose()).trace(), moment)
 }
 
 /// The factor that brings the energy `now` of a particle's affine and quadratic fields
@@ -254,9 +249,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                 };
                                 if let Some((frame, summed)) = ModeFrame::of_stencil(entries()) {
                                     let (c, modes) = (p.affine[i], p.quadratic[i]);
-                                    let d = match kernel.constant_second_moment() {
-                                        Some(s) => SMatrix::identity() * s,
-                                        None => summed,
+                                    let d = if varying_moment {
+                                        summed
+                                    } else {
+                                        SMatrix::identity() * constant_moment
                                     };
                                     let now = (c * d * c.transpose()).trace()
                                         + frame.energy(&modes, entries());
