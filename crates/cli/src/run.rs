@@ -236,7 +236,8 @@ fn run_dim<const D: usize, X: Dimension<D>>(
         | KernelKind::UmlsFrozenEta
         | KernelKind::UmlsUncorrected
         | KernelKind::UmlsEta4
-        | KernelKind::UmlsEta8 => {
+        | KernelKind::UmlsEta8
+        | KernelKind::UmlsElementSize => {
             let mesh = mesh()?;
             let mls = umls_settings(&ctx, &mesh)?;
             let kernel = corrected(&ctx, X::Umls::from_mls(mesh, mls))?;
@@ -295,6 +296,7 @@ fn umls_settings<const D: usize>(
     let support = match spec.support.unwrap_or(preset.support) {
         SupportSpec::PerVertex => SupportRadius::PerVertex { factor },
         SupportSpec::IncidentEdge => SupportRadius::IncidentEdge { factor },
+        SupportSpec::ElementSize => SupportRadius::ElementSize { factor },
         SupportSpec::Global => SupportRadius::Global { factor },
     };
     let mut mls = UmlsKernel::with_weight(mesh, weight, support)
@@ -326,6 +328,12 @@ const ETA8_EXPONENT: u32 = 8;
 /// See [`ETA8_EXPONENT`].
 const ETA8_SUPPORT_FACTOR: f64 = 2.8;
 
+/// The element-size support factor of `umls-element-size`: the radius of the cells' own
+/// size, the narrowest of the study in docs/umls-kernel.md (*Mesh layout*) whose vortex
+/// completes at four particles per cell (0.9 loses a particle at 60 cells) and the widest
+/// that brings the disks within 5 points of bspline2 under both transfers.
+const ELEMENT_SIZE_SUPPORT_FACTOR: f64 = 1.0;
+
 /// Relative ridge on the quadratic monomials of `umls-quadratic`.
 const QUADRATIC_RIDGE: f64 = 1e-3;
 
@@ -342,7 +350,8 @@ struct UmlsPreset {
 }
 
 /// Profile, radius rule, factor, gradient, exponent of η and integration correction of
-/// each UMLS kernel name. `umls-eta4` and `umls-eta8` change one part of `umls`; the
+/// each UMLS kernel name. `umls-eta4`, `umls-eta8` and `umls-element-size` change one
+/// part of `umls`; the
 /// other names change one part of `umls-uncorrected`, the kernel their studies measured
 /// against.
 fn umls_preset(kind: KernelKind) -> UmlsPreset {
@@ -394,6 +403,11 @@ fn umls_preset(kind: KernelKind) -> UmlsPreset {
         KernelKind::UmlsEta8 => UmlsPreset {
             factor: ETA8_SUPPORT_FACTOR,
             exponent: ETA8_EXPONENT,
+            ..umls
+        },
+        KernelKind::UmlsElementSize => UmlsPreset {
+            support: SupportSpec::ElementSize,
+            factor: ELEMENT_SIZE_SUPPORT_FACTOR,
             ..umls
         },
         _ => uncorrected,

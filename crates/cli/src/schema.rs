@@ -179,7 +179,8 @@ pub enum KernelKind {
     /// C¹ UMLS kernel on the mesh: linear basis, cubic B-spline weights with the
     /// incident-edge support radius, and the integration correction of its force
     /// gradients (docs/umls-kernel.md has the studies that chose them). The other UMLS
-    /// names but `umls-eta4` and `umls-eta8` (which vary `umls` itself) change one part of
+    /// names but `umls-eta4`, `umls-eta8` and `umls-element-size` (which vary `umls`
+    /// itself) change one part of
     /// `umls-uncorrected`, the kernel their studies measured against; `[kernel]
     /// integration_correction = true` corrects any of them.
     #[default]
@@ -216,6 +217,13 @@ pub enum KernelKind {
     /// further along the same frontier, the disks within 5 points of quadratic B-splines,
     /// the vortex at h/2 twice the default's error (docs/umls-kernel.md).
     UmlsEta8,
+    /// The `umls` kernel with the element-size support radius (factor 1.0): every
+    /// vertex's radius is its cells' size, so a lattice gets one radius where the
+    /// incident-edge rule widens the vertices on diagonals and long jittered edges. The
+    /// disks within 5 points of quadratic B-splines on the scene's own lattice and the
+    /// columns closer to exact; the vortex needs nine particles per cell to converge
+    /// (docs/umls-kernel.md, *Mesh layout*).
+    UmlsElementSize,
     /// Linear finite-element shape functions on the mesh.
     LinearFe,
     /// Quadratic B-splines on a Cartesian grid covering the mesh.
@@ -239,6 +247,7 @@ impl KernelKind {
             KernelKind::UmlsUncorrected => "umls-uncorrected",
             KernelKind::UmlsEta4 => "umls-eta4",
             KernelKind::UmlsEta8 => "umls-eta8",
+            KernelKind::UmlsElementSize => "umls-element-size",
             KernelKind::LinearFe => "linear-fe",
             KernelKind::Bspline2 => "bspline2",
             KernelKind::Bspline3 => "bspline3",
@@ -347,6 +356,7 @@ impl KernelKind {
                 | KernelKind::UmlsUncorrected
                 | KernelKind::UmlsEta4
                 | KernelKind::UmlsEta8
+                | KernelKind::UmlsElementSize
         )
     }
 }
@@ -395,6 +405,9 @@ pub enum SupportSpec {
     PerVertex,
     /// Per vertex: the longest edge incident to the vertex.
     IncidentEdge,
+    /// Per vertex: the edge of the right-angled simplex with the mean volume of the
+    /// vertex's simplices (h on any split of a lattice of cells h).
+    ElementSize,
     /// One radius, the mesh's longest edge (the paper's).
     Global,
 }

@@ -43,6 +43,19 @@ pub enum SupportRadius {
         /// Multiplier, > 1/2 keeps every host vertex weighted.
         factor: f64,
     },
+    /// h_v = factor · (D! · mean volume of the simplices containing v)^(1/D): the edge of
+    /// the right-angled simplex (legs of length h, volume h^D / D!) of the same volume,
+    /// so h on a lattice of cells h split into simplices (alternating, one-way or Kuhn),
+    /// however the cells are split, and h/√2 at every vertex of the crossed lattice. It
+    /// follows a graded mesh like [`SupportRadius::IncidentEdge`] but does not grow where
+    /// a vertex carries a cell's diagonal or a jittered long edge, so a uniform lattice
+    /// gets one radius (docs/umls-kernel.md, *Mesh layout*). The profile's support 2h_v
+    /// must exceed the longest edge from v for every host vertex to stay weighted: on
+    /// right-angled lattices factor > √D / 2.
+    ElementSize {
+        /// Multiplier.
+        factor: f64,
+    },
     /// One h = factor · (longest edge in the mesh) for all vertices, as in the paper
     /// (factor 1). Distances on a 1-ring reach 2h only in degenerate configurations,
     /// so d_v > 0 except there.
@@ -50,6 +63,32 @@ pub enum SupportRadius {
         /// Multiplier.
         factor: f64,
     },
+}
+
+/// Each vertex's element size (D! · mean volume of its simplices)^(1/D)
+/// ([`SupportRadius::ElementSize`]); 0 for a vertex in no simplex.
+fn element_sizes<const D: usize>(mesh: &SimplexMesh<D>) -> Vec<f64> {
+    let mut volume = vec![0.0f64; mesh.vertex_count()];
+    let mut count = vec![0u32; mesh.vertex_count()];
+    for s in 0..mesh.simplex_count() {
+        let v = mesh.volume(s).abs();
+        for &n in mesh.simplex(s) {
+            volume[n as usize] += v;
+            count[n as usize] += 1;
+        }
+    }
+    let factorial = (1..=D).product::<usize>() as f64;
+    volume
+        .iter()
+        .zip(&count)
+        .map(|(&v, &c)| {
+            if c == 0 {
+                0.0
+            } else {
+                (factorial * v / f64::from(c)).powf(1.0 / D as f64)
+            }
+        })
+        .collect()
 }
 
 /// The factor of the default support radius, [`SupportRadius::IncidentEdge`]: chosen by
@@ -100,6 +139,7 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
         let factor = match support {
             SupportRadius::PerVertex { factor }
             | SupportRadius::IncidentEdge { factor }
+            | SupportRadius::ElementSize { factor }
             | SupportRadius::Global { factor } => factor,
         };
         if !(factor.is_finite() && factor > 0.0) {
@@ -127,6 +167,10 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
                     })
                     .collect()
             }
+            SupportRadius::ElementSize { .. } => element_sizes(mesh)
+                .into_iter()
+                .map(|size| factor * size)
+                .collect(),
             SupportRadius::PerVertex { .. } => {
                 let mut reach = vec![0.0f64; mesh.vertex_count()];
                 for s in 0..mesh.simplex_count() {

@@ -259,3 +259,82 @@ fn support_radii_cover_every_stencil() {
             .all(|&h| h == mesh.max_edge_length())
     );
 }
+
+/// The element-size rule gives h_v = (D! · mean volume of v's simplices)^(1/D): h at every
+/// vertex of a lattice of cells h however the cells are split (alternating and one-way
+/// triangles, Kuhn tetrahedra), h/√2 on the crossed lattice, where the incident-edge rule
+/// gives the diagonal's vertices √2 times the others' radius; on a jittered lattice it
+/// stays near h, and it scales with a graded mesh's local cells.
+#[test]
+fn element_size_radii_are_the_cell_size_however_the_cells_are_split() {
+    let radii = |mesh: &umls_mesh::SimplexMesh<2>, factor: f64| {
+        UmlsKernel::with_weight(mesh, CubicBSpline, SupportRadius::ElementSize { factor })
+            .unwrap()
+            .support_radii()
+            .to_vec()
+    };
+    let h = 0.25;
+    for (diagonal, size) in [
+        (Diagonal::Alternating, h),
+        (Diagonal::Right, h),
+        (Diagonal::Left, h),
+        (Diagonal::Crossed, h / 2f64.sqrt()),
+    ] {
+        let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [4, 4])
+            .triangles(diagonal)
+            .unwrap();
+        for (v, r) in radii(&mesh, 0.9).into_iter().enumerate() {
+            assert!(
+                (r - 0.9 * size).abs() < 1e-14,
+                "{diagonal:?} vertex {v}: {r}"
+            );
+        }
+        let incident = UmlsKernel::new(&mesh);
+        let spread = incident
+            .support_radii()
+            .iter()
+            .fold(0.0, |m: f64, &r| m.max(r))
+            / incident
+                .support_radii()
+                .iter()
+                .fold(f64::MAX, |m, &r| m.min(r));
+        if diagonal == Diagonal::Alternating {
+            assert!((spread - 2f64.sqrt()).abs() < 1e-12, "{spread}");
+        }
+    }
+    let kuhn = Lattice::new([0.0; 3], [1.0; 3], [4, 4, 4])
+        .tetrahedra()
+        .unwrap();
+    let tets = UmlsKernel::with_weight(
+        &kuhn,
+        CubicBSpline,
+        SupportRadius::ElementSize { factor: 1.0 },
+    )
+    .unwrap();
+    assert!(tets.support_radii().iter().all(|&r| (r - h).abs() < 1e-14));
+    let jittered = Lattice::new([0.0, 0.0], [1.0, 1.0], [8, 8])
+        .jitter(0.2, 3)
+        .triangles(Diagonal::Alternating)
+        .unwrap();
+    let r = radii(&jittered, 1.0);
+    assert!(r.iter().all(|&r| (r - 0.125).abs() < 0.2 * 0.125), "{r:?}");
+    // The same radii from the triangles' corners (cross products), independently of the
+    // mesh's stored volumes: a graded mesh's radii follow its cells.
+    let mut area = vec![0.0; jittered.vertex_count()];
+    let mut count = vec![0.0; jittered.vertex_count()];
+    for t in jittered.simplices() {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|v| jittered.vertex(v as usize));
+        let (e1, e2) = (b - a, c - a);
+        for &v in t {
+            area[v as usize] += 0.5 * (e1.x * e2.y - e1.y * e2.x).abs();
+            count[v as usize] += 1.0;
+        }
+    }
+    for (v, r) in r.iter().enumerate() {
+        let expected = (2.0 * area[v] / count[v]).sqrt();
+        assert!(
+            (r - expected).abs() < 1e-14,
+            "vertex {v}: {r} against {expected}"
+        );
+    }
+}

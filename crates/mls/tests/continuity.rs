@@ -263,8 +263,8 @@ fn umls_values_and_reconstructed_gradients_are_continuous() {
 }
 
 /// Every UMLS variant the CLI names (docs/umls-kernel.md): the wide per-vertex reach,
-/// the paper's global radius, Wendland and sharpened weights, and the quadratic basis
-/// with its ridge,
+/// the paper's global radius, the element-size radius, Wendland and sharpened weights,
+/// and the quadratic basis with its ridge,
 /// in 2D and 3D. Narrow supports make vertices enter and leave by their distance weight
 /// too; that weight is C² in x, so continuity holds as for the default.
 #[test]
@@ -308,6 +308,12 @@ fn every_umls_variant_is_continuous() {
             Profile::CubicBSpline,
             SupportRadius::IncidentEdge { factor: 2.8 },
             8,
+        ),
+        (
+            "element-size",
+            Profile::CubicBSpline,
+            SupportRadius::ElementSize { factor: 1.0 },
+            1,
         ),
     ];
     let tets = Lattice::new([0.0; 3], [1.0; 3], [3, 3, 3])

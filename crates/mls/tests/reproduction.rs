@@ -13,7 +13,7 @@ use umls_mls::{
 
 /// The UMLS variants the CLI names (docs/umls-kernel.md): profile and radius rule (the
 /// exponent of η is in [`EXPONENTS`]).
-const VARIANTS: [(Profile, SupportRadius); 8] = [
+const VARIANTS: [(Profile, SupportRadius); 9] = [
     (
         Profile::CubicBSpline,
         SupportRadius::IncidentEdge { factor: 0.9 },
@@ -45,11 +45,15 @@ const VARIANTS: [(Profile, SupportRadius); 8] = [
         Profile::CubicBSpline,
         SupportRadius::IncidentEdge { factor: 2.8 },
     ),
+    (
+        Profile::CubicBSpline,
+        SupportRadius::ElementSize { factor: 1.0 },
+    ),
 ];
 
-/// The exponent p of the weights η^p · d of each of [`VARIANTS`]: 4 and 8 for the last
-/// two, `umls-eta4` and `umls-eta8`, 1 for the others.
-const EXPONENTS: [u32; 8] = [1, 1, 1, 1, 1, 1, 4, 8];
+/// The exponent p of the weights η^p · d of each of [`VARIANTS`]: 4 and 8 for
+/// `umls-eta4` and `umls-eta8`, 1 for the others.
+const EXPONENTS: [u32; 9] = [1, 1, 1, 1, 1, 1, 4, 8, 1];
 
 /// Σ N_v = 1, Σ ∇N_v = 0, Σ N_v x_v = x, Σ x_v ∇N_vᵀ = I, for the linear basis and the
 /// default kernel.

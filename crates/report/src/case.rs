@@ -160,13 +160,14 @@ pub fn cases(matrix: &Matrix) -> Vec<Case> {
             vec![crate::matrix::Variant {
                 label: String::new(),
                 set: vec![],
+                kernels: vec![],
             }]
         } else {
             study.variants.clone()
         };
         for kernel in &study.common.kernels {
             for transfer in transfers(&study.common) {
-                for variant in &variants {
+                for variant in variants.iter().filter(|v| v.runs_with(kernel)) {
                     for &refine in &study.refine {
                         let mut case = base(
                             &study.common,

@@ -80,6 +80,17 @@ pub struct Variant {
     /// `KEY=VALUE` edits.
     #[serde(default)]
     pub set: Vec<String>,
+    /// The study's kernels that run it (empty: all of them), for a variant only some
+    /// kernels see, such as a mesh layout that a B-spline grid ignores.
+    #[serde(default)]
+    pub kernels: Vec<String>,
+}
+
+impl Variant {
+    /// Whether `kernel` runs this variant.
+    pub fn runs_with(&self, kernel: &str) -> bool {
+        self.kernels.is_empty() || self.kernels.iter().any(|k| k == kernel)
+    }
 }
 
 /// `[[accuracy]]`.
@@ -255,6 +266,14 @@ impl Matrix {
             if !(s.h.is_finite() && s.h > 0.0) {
                 return Err(bad(format!("{n}.h"), "must be positive"));
             }
+            for v in &s.variants {
+                if let Some(k) = v.kernels.iter().find(|k| !s.common.kernels.contains(k)) {
+                    return Err(bad(
+                        format!("{n}.variants `{}`.kernels", v.label),
+                        &format!("`{k}` is not one of the study's kernels"),
+                    ));
+                }
+            }
         }
         for s in &self.stability {
             let n = &s.common.name;
@@ -362,5 +381,40 @@ mod tests {
         ] {
             assert_eq!(transfer_edits(bad), None, "{bad}");
         }
+    }
+
+    /// A variant may name the kernels that run it, only among the study's own.
+    #[test]
+    fn a_variant_names_only_kernels_of_its_study() {
+        let matrix = |kernels: &str| {
+            format!(
+                r#"title = "t"
+[[accuracy]]
+name = "a"
+title = "a"
+scene = "vortex"
+metric = "m"
+metric_label = "m"
+kernels = ["umls", "bspline2"]
+refine = [1]
+h = 0.1
+variants = [{{ label = "v", kernels = {kernels} }}]
+"#
+            )
+        };
+        let ok = Matrix::parse(&matrix(r#"["umls"]"#), "m.toml").unwrap();
+        let variant = &ok.accuracy[0].variants[0];
+        assert!(variant.runs_with("umls") && !variant.runs_with("bspline2"));
+        let every = Matrix::parse(&matrix("[]"), "m.toml").unwrap();
+        assert!(every.accuracy[0].variants[0].runs_with("bspline2"));
+        let err = Matrix::parse(&matrix(r#"["linear-fe"]"#), "m.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("m.toml")
+                && err.contains("a.variants `v`.kernels")
+                && err.contains("`linear-fe`"),
+            "{err}"
+        );
     }
 }
