@@ -329,9 +329,9 @@ const ETA8_EXPONENT: u32 = 8;
 const ETA8_SUPPORT_FACTOR: f64 = 2.8;
 
 /// The element-size support factor of `umls-element-size`: the radius of the cells' own
-/// size, the narrowest of the study in docs/umls-kernel.md (*Mesh layout*) whose vortex
-/// completes at four particles per cell (0.9 loses a particle at 60 cells) and the widest
-/// that brings the disks within 5 points of bspline2 under both transfers.
+/// size, the narrowest of the sweep in docs/umls-kernel.md (*Element-size radii*) whose
+/// vortex completes at four particles per cell (0.9 loses a particle at 60 cells) and
+/// the widest that brings the disks within 5 points of bspline2 under both transfers.
 const ELEMENT_SIZE_SUPPORT_FACTOR: f64 = 1.0;
 
 /// Relative ridge on the quadratic monomials of `umls-quadratic`.
@@ -351,9 +351,8 @@ struct UmlsPreset {
 
 /// Profile, radius rule, factor, gradient, exponent of η and integration correction of
 /// each UMLS kernel name. `umls-eta4`, `umls-eta8` and `umls-element-size` change one
-/// part of `umls`; the
-/// other names change one part of `umls-uncorrected`, the kernel their studies measured
-/// against.
+/// part of `umls`; the other names change one part of `umls-uncorrected`, the kernel
+/// their studies measured against.
 fn umls_preset(kind: KernelKind) -> UmlsPreset {
     let umls = UmlsPreset {
         weight: WeightSpec::CubicBspline,

@@ -222,7 +222,7 @@ pub enum KernelKind {
     /// incident-edge rule widens the vertices on diagonals and long jittered edges. The
     /// disks within 5 points of quadratic B-splines on the scene's own lattice and the
     /// columns closer to exact; the vortex needs nine particles per cell to converge
-    /// (docs/umls-kernel.md, *Mesh layout*).
+    /// (docs/umls-kernel.md, *Element-size radii*).
     UmlsElementSize,
     /// Linear finite-element shape functions on the mesh.
     LinearFe,

@@ -49,9 +49,9 @@ pub enum SupportRadius {
     /// however the cells are split, and h/√2 at every vertex of the crossed lattice. It
     /// follows a graded mesh like [`SupportRadius::IncidentEdge`] but does not grow where
     /// a vertex carries a cell's diagonal or a jittered long edge, so a uniform lattice
-    /// gets one radius (docs/umls-kernel.md, *Mesh layout*). The profile's support 2h_v
-    /// must exceed the longest edge from v for every host vertex to stay weighted: on
-    /// right-angled lattices factor > √D / 2.
+    /// gets one radius (docs/umls-kernel.md, *Element-size radii*). The profile's
+    /// support 2h_v must exceed the longest edge from v for every host vertex to stay
+    /// weighted: on right-angled lattices factor > √D / 2.
     ElementSize {
         /// Multiplier.
         factor: f64,
