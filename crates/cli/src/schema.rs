@@ -180,9 +180,8 @@ pub enum KernelKind {
     /// incident-edge support radius, and the integration correction of its force
     /// gradients (docs/umls-kernel.md has the studies that chose them). The other UMLS
     /// names but `umls-eta4`, `umls-eta8` and `umls-element-size` (which vary `umls`
-    /// itself) change one part of
-    /// `umls-uncorrected`, the kernel their studies measured against; `[kernel]
-    /// integration_correction = true` corrects any of them.
+    /// itself) change one part of `umls-uncorrected`, the kernel their studies measured
+    /// against; `[kernel] integration_correction = true` corrects any of them.
     #[default]
     Umls,
     /// UMLS with the quadratic basis on the 1-ring (ridge on the quadratic terms).

@@ -65,30 +65,19 @@ pub enum SupportRadius {
     },
 }
 
-/// Each vertex's element size (D! · mean volume of its simplices)^(1/D)
+/// Vertex `v`'s element size (D! · mean volume of its simplices)^(1/D)
 /// ([`SupportRadius::ElementSize`]); 0 for a vertex in no simplex.
-fn element_sizes<const D: usize>(mesh: &SimplexMesh<D>) -> Vec<f64> {
-    let mut volume = vec![0.0f64; mesh.vertex_count()];
-    let mut count = vec![0u32; mesh.vertex_count()];
-    for s in 0..mesh.simplex_count() {
-        let v = mesh.volume(s).abs();
-        for &n in mesh.simplex(s) {
-            volume[n as usize] += v;
-            count[n as usize] += 1;
-        }
+fn element_size<const D: usize>(mesh: &SimplexMesh<D>, v: usize) -> f64 {
+    let simplices = mesh.topology().vertex_simplices(v);
+    if simplices.is_empty() {
+        return 0.0;
     }
-    let factorial = (1..=D).product::<usize>() as f64;
-    volume
+    let volume: f64 = simplices
         .iter()
-        .zip(&count)
-        .map(|(&v, &c)| {
-            if c == 0 {
-                0.0
-            } else {
-                (factorial * v / f64::from(c)).powf(1.0 / D as f64)
-            }
-        })
-        .collect()
+        .map(|&s| mesh.volume(s as usize).abs())
+        .sum();
+    let factorial = (1..=D).product::<usize>() as f64;
+    (factorial * volume / simplices.len() as f64).powf(1.0 / D as f64)
 }
 
 /// The factor of the default support radius, [`SupportRadius::IncidentEdge`]: chosen by
@@ -167,9 +156,8 @@ impl<const D: usize, W: WeightFunction> UmlsKernel<D, W> {
                     })
                     .collect()
             }
-            SupportRadius::ElementSize { .. } => element_sizes(mesh)
-                .into_iter()
-                .map(|size| factor * size)
+            SupportRadius::ElementSize { .. } => (0..mesh.vertex_count())
+                .map(|v| factor * element_size(mesh, v))
                 .collect(),
             SupportRadius::PerVertex { .. } => {
                 let mut reach = vec![0.0f64; mesh.vertex_count()];
