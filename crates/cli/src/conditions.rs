@@ -4,11 +4,11 @@
 //! reported.
 
 use nalgebra::SVector;
-use umls_engine::{FittedClamp, Wall, WallKind};
+use umls_engine::{FaceClamp, FittedClamp, Wall, WallKind, face_points};
 
 use crate::error::Result;
 use crate::run::{Context, Run};
-use crate::schema::BoundaryKind;
+use crate::schema::{BoundaryKind, Imposed};
 use crate::setup::BoundaryTarget;
 
 /// Walls on planes, and fixed or slip conditions on the nodes of mesh groups.
@@ -99,7 +99,8 @@ pub(crate) fn apply_boundaries<const D: usize>(
             BoundaryTarget::Region {
                 region,
                 normal,
-                fitted,
+                imposed,
+                penalty,
             } => {
                 let frame = &ctx.setup.frame;
                 // Indices of the points (world frame) inside the region (scene frame).
@@ -119,7 +120,30 @@ pub(crate) fn apply_boundaries<const D: usize>(
                     ));
                 }
                 match normal {
-                    None if *fitted => {
+                    None if *imposed == Imposed::Face => {
+                        let contains =
+                            |x: &SVector<f64, D>| region.contains(&frame.point_to_scene(x));
+                        let points = face_points(sim.positions(), contains, face_reach(sim));
+                        if points.is_empty() {
+                            return Err(scene.value_error(
+                                format!("boundaries[{i}].imposed"),
+                                "a clamp held on its face needs particles on both sides of the region's boundary",
+                            ));
+                        }
+                        let mut clamp = FaceClamp::new(nodes.clone(), points);
+                        if let Some(w) = penalty {
+                            clamp.penalty = *w;
+                        }
+                        let moved = sim.add_face_clamp(clamp).map_err(|(point, e)| {
+                            scene.value_error(
+                                format!("boundaries[{i}].region"),
+                                format!("face point {point}: {e}"),
+                            )
+                        })?;
+                        sim.boundary().reaction_sets.push(moved);
+                        continue;
+                    }
+                    None if *imposed == Imposed::Fit => {
                         let particles = inside(sim.positions());
                         if particles.is_empty() {
                             return Err(scene.value_error(
@@ -139,4 +163,12 @@ pub(crate) fn apply_boundaries<const D: usize>(
         }
     }
     Ok(())
+}
+
+/// How far apart two particles may be for a face point between them: 1.5 times the
+/// largest particle spacing V_p^(1/D), so that a lattice's diagonal neighbours count and
+/// a jittered lattice's gaps are bridged.
+fn face_reach<const D: usize>(sim: &dyn Run<D>) -> f64 {
+    let largest = sim.volumes().iter().copied().fold(0.0, f64::max);
+    1.5 * largest.powf(1.0 / D as f64)
 }

@@ -13,9 +13,9 @@ use std::time::Instant;
 use nalgebra::{SMatrix, SVector};
 use serde_json::json;
 use umls_engine::{
-    Apic, ApicFlip, Boundary, Diagnostics, EngineError, Flip, MlsMpm, Particles, QuadraticApicFlip,
-    Simulation, StageTimes, StepSettings, TimeStepControl, TransferScheme, VelocityGradientAffine,
-    Wall,
+    Apic, ApicFlip, Boundary, Diagnostics, EngineError, FaceClamp, Flip, MlsMpm, Particles,
+    QuadraticApicFlip, Simulation, StageTimes, StepSettings, TimeStepControl, TransferScheme,
+    VelocityGradientAffine, Wall,
 };
 use umls_io::csv::HistoryWriter;
 use umls_io::vtk::Encoding;
@@ -25,7 +25,7 @@ use umls_mls::{
     DEFAULT_SHARPENING, DEFAULT_SUPPORT_FACTOR, Linear, Profile, Quadratic, SharpenedBSpline,
     SupportRadius, UmlsKernel,
 };
-use umls_transfer::Kernel;
+use umls_transfer::{Kernel, KernelError};
 
 use crate::error::{CliError, Result};
 use crate::output::OutputDir;
@@ -636,6 +636,14 @@ pub(crate) trait Run<const D: usize> {
     fn spacing(&self) -> f64;
     /// Adds a wall; the nodes it constrains.
     fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> Vec<u32>;
+    /// Adds a clamp held on its face; the nodes its constraint moves (or the face point
+    /// the kernel cannot evaluate, with the kernel's error).
+    fn add_face_clamp(
+        &mut self,
+        clamp: FaceClamp<D>,
+    ) -> std::result::Result<Vec<u32>, (usize, KernelError)>;
+    /// The particles' reference volumes.
+    fn volumes(&self) -> &[f64];
     /// The constraint forces of the boundary's reaction sets in the last step.
     fn reactions(&self) -> &[umls_engine::Reaction<D>];
     /// Each reaction-set node's reaction, the sets one after the other.
@@ -717,6 +725,15 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
     }
     fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> Vec<u32> {
         self.boundary.add_wall(&self.kernel, wall, tolerance)
+    }
+    fn add_face_clamp(
+        &mut self,
+        clamp: FaceClamp<D>,
+    ) -> std::result::Result<Vec<u32>, (usize, KernelError)> {
+        self.boundary.add_face_clamp(&self.kernel, clamp)
+    }
+    fn volumes(&self) -> &[f64] {
+        &self.particles().volume
     }
     fn boundary(&mut self) -> &mut Boundary<D> {
         &mut self.boundary

@@ -892,8 +892,12 @@ pub struct BoundarySpec {
     pub region: Option<RegionSpec>,
     /// The wall normal of a slip condition on a region.
     pub normal: Option<Vec<f64>>,
-    /// How a fixed region holds the body: on its nodes (default) or on the fit.
+    /// How a fixed region holds the body: on its nodes (default), on the fit or on its
+    /// face.
     pub imposed: Option<Imposed>,
+    /// The weight of the face points' residuals against the heaviest node's mass, for
+    /// `imposed = "face"` (default `umls_engine::FACE_CLAMP_PENALTY`).
+    pub penalty: Option<f64>,
 }
 
 /// `imposed` of a fixed region: where the zero velocity is imposed.
@@ -907,6 +911,11 @@ pub enum Imposed {
     /// mass-weighted least-squares sense (`umls_engine::FittedClamp`): the clamp ends
     /// where those particles end.
     Fit,
+    /// The velocity vanishes on the region's face, where the body crosses its boundary,
+    /// by the least mass-weighted change of the nodes around it; the region's other nodes
+    /// are at rest (`umls_engine::FaceClamp`): the clamp's edge is the face, whatever the
+    /// node layout.
+    Face,
 }
 
 /// `[reference]`: an analytic velocity field v(X, t) or displacement u(X, t) at the

@@ -72,8 +72,11 @@ pub enum BoundaryTarget<const D: usize> {
         region: Region<D>,
         /// Unit normal (slip only).
         normal: Option<SVector<f64, D>>,
-        /// A fixed region imposed on the fit at the particles inside it, not on its nodes.
-        fitted: bool,
+        /// How a fixed region holds the body: on its nodes, on the fit at the particles
+        /// inside it, or on its face (`Nodes` for slip).
+        imposed: Imposed,
+        /// The face clamp's penalty (`imposed = "face"` only).
+        penalty: Option<f64>,
     },
 }
 
@@ -774,6 +777,12 @@ pub fn build_for<const D: usize>(
                 "only a `region` condition takes `imposed`",
             ));
         }
+        if b.penalty.is_some() && b.imposed != Some(Imposed::Face) {
+            return Err(scene.value_error(
+                format!("boundaries[{i}].penalty"),
+                "weighs a clamp held on its face: give it with imposed = \"face\"",
+            ));
+        }
         if b.normal.is_some() && b.region.is_none() {
             return Err(scene.value_error(
                 format!("boundaries[{i}].normal"),
@@ -808,20 +817,31 @@ pub fn build_for<const D: usize>(
                         ));
                     }
                 };
-                let fitted = match (b.imposed, b.kind) {
-                    (None | Some(Imposed::Nodes), _) => false,
-                    (Some(Imposed::Fit), BoundaryKind::Fixed) => true,
-                    (Some(Imposed::Fit), BoundaryKind::Slip) => {
+                let imposed = match (b.imposed, b.kind) {
+                    (None | Some(Imposed::Nodes), _) => Imposed::Nodes,
+                    (Some(imposed), BoundaryKind::Fixed) => imposed,
+                    (Some(_), BoundaryKind::Slip) => {
                         return Err(scene.value_error(
                             format!("boundaries[{i}].imposed"),
-                            "only a fixed region can be imposed on the fit",
+                            "only a fixed region can be imposed on the fit or its face",
                         ));
                     }
+                };
+                // Given only with imposed = "face" (checked above).
+                let penalty = match b.penalty {
+                    Some(w) if !(w.is_finite() && w > 0.0) => {
+                        return Err(scene.value_error(
+                            format!("boundaries[{i}].penalty"),
+                            "must be finite and positive",
+                        ));
+                    }
+                    w => w,
                 };
                 BoundaryTarget::Region {
                     region: region(scene, &format!("boundaries[{i}].region"), spec)?,
                     normal,
-                    fitted,
+                    imposed,
+                    penalty,
                 }
             }
             (Some(plane), None, None) => {

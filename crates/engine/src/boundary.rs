@@ -16,8 +16,9 @@
 use crate::scatter::{LIVE_SEGMENT, NODE_CHUNK, SEGMENTS_PER_CHUNK};
 use nalgebra::SVector;
 use rayon::prelude::*;
-use umls_transfer::{DomainExit, Kernel};
+use umls_transfer::{DomainExit, Kernel, KernelError, Stencil};
 
+use crate::face_clamp::FaceClamp;
 use crate::fitted_clamp::FittedClamp;
 
 /// Per-node marks of [`Boundary::node_marks`].
@@ -102,6 +103,9 @@ pub struct Boundary<const D: usize> {
     /// Clamps imposed on the fit: their nodes take the velocities under which their
     /// particles neither move nor deform, in the least-squares sense ([`FittedClamp`]).
     pub fitted: Vec<FittedClamp>,
+    /// Clamps held on their face: the velocity vanishes where the body crosses the
+    /// clamp's boundary, the clamp's other nodes are at rest ([`FaceClamp`]).
+    pub faces: Vec<FaceClamp<D>>,
 }
 
 /// The force the constraints of one reaction set exert on the body in the last step.
@@ -162,6 +166,29 @@ impl<const D: usize> Boundary<D> {
         }
         self.walls.push(wall);
         nodes
+    }
+
+    /// Adds a clamp held on its face, after checking that the kernel evaluates a stencil
+    /// at each of its points (else the point's index and the kernel's error). Returns
+    /// the nodes its constraint moves, for a reaction set: the clamp's nodes and those
+    /// of its points' stencils.
+    pub fn add_face_clamp<K: Kernel<D>>(
+        &mut self,
+        kernel: &K,
+        clamp: FaceClamp<D>,
+    ) -> Result<Vec<u32>, (usize, KernelError)> {
+        let mut nodes = clamp.nodes().to_vec();
+        let mut stencil = Stencil::new();
+        for (point, x) in clamp.points().iter().enumerate() {
+            kernel
+                .stencil(x, &mut K::Cache::default(), &mut stencil)
+                .map_err(|e| (point, e))?;
+            nodes.extend_from_slice(stencil.nodes());
+        }
+        nodes.sort_unstable();
+        nodes.dedup();
+        self.faces.push(clamp);
+        Ok(nodes)
     }
 
     /// Applies the node conditions to grid velocities.
@@ -232,7 +259,10 @@ impl<const D: usize> Boundary<D> {
 
     /// Whether any node condition is set (walls given as node sets, such as mesh groups).
     pub(crate) fn has_node_conditions(&self) -> bool {
-        !self.fixed.is_empty() || !self.slip.is_empty() || !self.fitted.is_empty()
+        !self.fixed.is_empty()
+            || !self.slip.is_empty()
+            || !self.fitted.is_empty()
+            || !self.faces.is_empty()
     }
 
     /// Marks per node: fixed, slip, or free.
@@ -245,6 +275,7 @@ impl<const D: usize> Boundary<D> {
             .fixed
             .iter()
             .chain(self.fitted.iter().flat_map(|c| c.nodes()))
+            .chain(self.faces.iter().flat_map(|c| c.nodes()))
         {
             marks[node as usize] |= FIXED;
         }

@@ -19,6 +19,19 @@ pub enum EngineError {
         /// The kernel's error.
         source: KernelError,
     },
+    /// The kernel could not evaluate the stencil at a face clamp's point (outside the
+    /// domain, or an ill-conditioned MLS system).
+    #[error("step {step}, face clamp {clamp}, face point {point}: {source}")]
+    FacePoint {
+        /// Step number.
+        step: usize,
+        /// The clamp's position in [`crate::Boundary::faces`].
+        clamp: usize,
+        /// The point's position in [`crate::FaceClamp::points`].
+        point: usize,
+        /// The kernel's error.
+        source: KernelError,
+    },
     /// The material model rejected a particle's deformation.
     #[error("step {step}, particle {particle}: {source}")]
     Material {
@@ -192,7 +205,7 @@ impl EngineError {
     /// `time-step-too-large`, `initial-stress`, `invalid-parameter` or `unsupported`.
     pub fn kind(&self) -> &'static str {
         match self {
-            Self::Kernel { .. } => "kernel",
+            Self::Kernel { .. } | Self::FacePoint { .. } => "kernel",
             Self::Material { .. } => "material",
             Self::NonFinite { .. } => "non-finite",
             Self::Inverted { .. } => "inverted",

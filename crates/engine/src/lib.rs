@@ -54,6 +54,7 @@
 mod boundary;
 mod diagnostics;
 mod error;
+mod face_clamp;
 mod fitted_clamp;
 pub mod geostatic;
 mod grid;
@@ -72,6 +73,7 @@ mod transfer;
 pub use boundary::{Boundary, Reaction, Wall, WallKind};
 pub use diagnostics::Diagnostics;
 pub use error::EngineError;
+pub use face_clamp::{FACE_CLAMP_PENALTY, FACE_CLAMP_REGULARISATION, FaceClamp, face_points};
 pub use fitted_clamp::{FITTED_CLAMP_REGULARISATION, FittedClamp};
 pub use memory::MemoryUse;
 pub use particles::Particles;

@@ -126,6 +126,8 @@ pub struct Simulation<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: Trans
     ),
     /// This step's least-squares systems of the boundary's fitted clamps.
     clamp_systems: Vec<crate::fitted_clamp::ClampSystem<D>>,
+    /// This step's systems of the boundary's face clamps.
+    face_systems: Vec<crate::face_clamp::FaceSystem>,
     /// Buffers of the mass-matrix iterations (empty without them).
     mass_solve: mass_matrix::MassSolve<D>,
     /// Per stored particle, its index at construction (empty until the first sort:
@@ -268,6 +270,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             stresses_current: false,
             reactions: Default::default(),
             clamp_systems: Vec::new(),
+            face_systems: Vec::new(),
             mass_solve: Default::default(),
             ids: Vec::new(),
             sorts: 0,
@@ -620,7 +623,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         }
         // Fitted clamps change node velocities after the update, so with them the
         // reactions are taken around both.
-        let fitted = !self.boundary.fitted.is_empty();
+        let fitted = !self.boundary.fitted.is_empty() || !self.boundary.faces.is_empty();
         if measure && fitted {
             self.reactions
                 .0

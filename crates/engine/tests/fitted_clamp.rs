@@ -8,40 +8,15 @@
 //!   holds them closer to rest, stays stable, and conserves what the reactions account
 //!   for.
 
-use std::sync::Arc;
-
 use nalgebra::{SVector, Vector2};
 use umls_constitutive::{ElasticParameters, NeoHookean};
-use umls_engine::{Boundary, FittedClamp, Flip, Particles, Simulation, StepSettings, StressUpdate};
-use umls_kernels::{HostCache, Umls2};
-use umls_mesh::SimplexMesh;
-use umls_mesh::generate::{Diagonal, Lattice};
+use umls_engine::{Boundary, FittedClamp, Flip, Simulation, StepSettings, StressUpdate};
+use umls_kernels::Umls2;
 use umls_transfer::Kernel;
 
-/// The room [−1.5, 3.5] × [−2, 1.5] in cells of 0.25, turned by `angle` about its centre.
-fn mesh(angle: f64) -> Arc<SimplexMesh<2>> {
-    Arc::new(
-        Lattice::new([-1.5, -2.0], [3.5, 1.5], [20, 14])
-            .rotate_by(angle)
-            .triangles(Diagonal::Alternating)
-            .unwrap(),
-    )
-}
-
-/// The beam [−0.5, 2.5] × [0, 0.5], 0.125 apart; the part at x < 0 is embedded.
-fn beam() -> Particles<2, (), HostCache<2>> {
-    let mut x = Vec::new();
-    for i in 0..24 {
-        for j in 0..4 {
-            x.push(Vector2::new(
-                -0.5 + (i as f64 + 0.5) * 0.125,
-                (j as f64 + 0.5) * 0.125,
-            ));
-        }
-    }
-    let n = x.len();
-    Particles::at_rest(x, vec![0.125 * 0.125; n], 1000.0, ())
-}
+#[path = "common/clamped_beam.rs"]
+mod clamped_beam;
+use clamped_beam::{beam, mesh};
 
 /// How the clamp region x ≤ 0 is imposed.
 #[derive(Clone, Copy, PartialEq)]
@@ -74,7 +49,7 @@ fn run_with(
     steps: usize,
     update: StressUpdate,
 ) -> Outcome {
-    let mesh = mesh(angle);
+    let mesh = mesh(0.0, angle);
     let kernel = Umls2::new(mesh.clone());
     let material = NeoHookean {
         parameters: ElasticParameters::from_young_poisson(1e6, 0.3).unwrap(),
@@ -188,7 +163,7 @@ fn a_clamp_covering_the_stencils_fits_to_the_node_clamp() {
 /// A clamp naming a particle that does not exist is an error that says so.
 #[test]
 fn a_clamp_particle_beyond_the_count_is_named() {
-    let mesh = mesh(0.0);
+    let mesh = mesh(0.0, 0.0);
     let material = NeoHookean {
         parameters: ElasticParameters::from_young_poisson(1e6, 0.3).unwrap(),
     };

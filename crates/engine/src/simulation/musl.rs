@@ -50,6 +50,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         for (clamp, system) in self.boundary.fitted.iter().zip(&self.clamp_systems) {
             clamp.fit(system, &mut g.velocity);
         }
+        for (clamp, system) in self.boundary.faces.iter().zip(&self.face_systems) {
+            clamp.hold(system, &mut g.velocity);
+        }
         let v = &g.velocity;
         self.stress_buffer
             .par_iter_mut()
