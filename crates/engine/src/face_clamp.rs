@@ -314,6 +314,39 @@ mod tests {
         assert!(energy(&after) <= energy(&before));
     }
 
+    /// In 3D the face of a block of particles 4 × 4 × 4, 0.1 apart, cut by x = 0 is
+    /// sampled on the plane across the block's whole section, no two points closer than
+    /// half the reach.
+    #[test]
+    fn face_points_sample_a_plane_through_a_block() {
+        let mut x = Vec::new();
+        for i in 0..4 {
+            for j in 0..4 {
+                for k in 0..4 {
+                    let c = |n: usize| (n as f64 - 1.5) * 0.1;
+                    x.push(SVector::<f64, 3>::new(c(i), c(j) + 1.0, c(k)));
+                }
+            }
+        }
+        let reach = 0.15;
+        let points = face_points(&x, |x| x.x <= 0.0, reach);
+        assert!(points.iter().all(|p| p.x.abs() < 1e-9));
+        for j in 0..4 {
+            for k in 0..4 {
+                let (y, z) = ((j as f64 - 1.5) * 0.1 + 1.0, (k as f64 - 1.5) * 0.1);
+                let near = |p: &SVector<f64, 3>| (p.y - y).hypot(p.z - z) <= 0.075;
+                assert!(points.iter().any(near), "no point near ({y}, {z})");
+            }
+        }
+        for (a, p) in points.iter().enumerate() {
+            assert!(
+                points[a + 1..]
+                    .iter()
+                    .all(|q| (p - q).norm() >= reach / 2.0)
+            );
+        }
+    }
+
     /// With no mass near the face there is nothing to hold: the region is at rest and
     /// the other nodes keep their velocities.
     #[test]
