@@ -4,7 +4,7 @@
 //! reported.
 
 use nalgebra::SVector;
-use umls_engine::{FaceClamp, FittedClamp, Wall, WallKind, face_points};
+use umls_engine::{FittedClamp, Wall, WallKind, face_points};
 
 use crate::error::Result;
 use crate::run::{Context, Run};
@@ -130,16 +130,11 @@ pub(crate) fn apply_boundaries<const D: usize>(
                                 "a clamp held on its face needs particles on both sides of the region's boundary",
                             ));
                         }
-                        let mut clamp = FaceClamp::new(nodes.clone(), points);
-                        if let Some(w) = penalty {
-                            clamp.penalty = *w;
-                        }
-                        let moved = sim.add_face_clamp(clamp).map_err(|(point, e)| {
-                            scene.value_error(
-                                format!("boundaries[{i}].region"),
-                                format!("face point {point}: {e}"),
-                            )
-                        })?;
+                        let moved = sim
+                            .add_face_clamp(nodes.clone(), points, *penalty)
+                            .map_err(|e| {
+                                scene.value_error(format!("boundaries[{i}].region"), e.to_string())
+                            })?;
                         sim.boundary().reaction_sets.push(moved);
                         continue;
                     }

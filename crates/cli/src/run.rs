@@ -25,7 +25,7 @@ use umls_mls::{
     DEFAULT_SHARPENING, DEFAULT_SUPPORT_FACTOR, Linear, Profile, Quadratic, SharpenedBSpline,
     SupportRadius, UmlsKernel,
 };
-use umls_transfer::{Kernel, KernelError};
+use umls_transfer::Kernel;
 
 use crate::error::{CliError, Result};
 use crate::output::OutputDir;
@@ -636,12 +636,15 @@ pub(crate) trait Run<const D: usize> {
     fn spacing(&self) -> f64;
     /// Adds a wall; the nodes it constrains.
     fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> Vec<u32>;
-    /// Adds a clamp held on its face; the nodes its constraint moves (or the face point
-    /// the kernel cannot evaluate, with the kernel's error).
+    /// Adds a clamp held on its face, the region's `nodes` and the face `points`, with
+    /// the face points' residuals weighted by `penalty` (else the default); the nodes its
+    /// constraint moves (or the face point the kernel cannot evaluate).
     fn add_face_clamp(
         &mut self,
-        clamp: FaceClamp<D>,
-    ) -> std::result::Result<Vec<u32>, (usize, KernelError)>;
+        nodes: Vec<u32>,
+        points: Vec<SVector<f64, D>>,
+        penalty: Option<f64>,
+    ) -> std::result::Result<Vec<u32>, EngineError>;
     /// The particles' reference volumes.
     fn volumes(&self) -> &[f64];
     /// The constraint forces of the boundary's reaction sets in the last step.
@@ -728,9 +731,15 @@ impl<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme> Run<D>
     }
     fn add_face_clamp(
         &mut self,
-        clamp: FaceClamp<D>,
-    ) -> std::result::Result<Vec<u32>, (usize, KernelError)> {
-        self.boundary.add_face_clamp(&self.kernel, clamp)
+        nodes: Vec<u32>,
+        points: Vec<SVector<f64, D>>,
+        penalty: Option<f64>,
+    ) -> std::result::Result<Vec<u32>, EngineError> {
+        let mut clamp = FaceClamp::new(&self.kernel, nodes, points)?;
+        if let Some(w) = penalty {
+            clamp.penalty = w;
+        }
+        Ok(self.boundary.add_face_clamp(clamp))
     }
     fn volumes(&self) -> &[f64] {
         &self.particles().volume

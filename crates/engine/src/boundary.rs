@@ -16,7 +16,7 @@
 use crate::scatter::{LIVE_SEGMENT, NODE_CHUNK, SEGMENTS_PER_CHUNK};
 use nalgebra::SVector;
 use rayon::prelude::*;
-use umls_transfer::{DomainExit, Kernel, KernelError, Stencil};
+use umls_transfer::{DomainExit, Kernel};
 
 use crate::face_clamp::FaceClamp;
 use crate::fitted_clamp::FittedClamp;
@@ -168,27 +168,12 @@ impl<const D: usize> Boundary<D> {
         nodes
     }
 
-    /// Adds a clamp held on its face, after checking that the kernel evaluates a stencil
-    /// at each of its points (else the point's index and the kernel's error). Returns
-    /// the nodes its constraint moves, for a reaction set: the clamp's nodes and those
-    /// of its points' stencils.
-    pub fn add_face_clamp<K: Kernel<D>>(
-        &mut self,
-        kernel: &K,
-        clamp: FaceClamp<D>,
-    ) -> Result<Vec<u32>, (usize, KernelError)> {
-        let mut nodes = clamp.nodes().to_vec();
-        let mut stencil = Stencil::new();
-        for (point, x) in clamp.points().iter().enumerate() {
-            kernel
-                .stencil(x, &mut K::Cache::default(), &mut stencil)
-                .map_err(|e| (point, e))?;
-            nodes.extend_from_slice(stencil.nodes());
-        }
-        nodes.sort_unstable();
-        nodes.dedup();
+    /// Adds a clamp held on its face. Returns the nodes its constraint moves, for a
+    /// reaction set ([`FaceClamp::moved_nodes`]).
+    pub fn add_face_clamp(&mut self, clamp: FaceClamp<D>) -> Vec<u32> {
+        let nodes = clamp.moved_nodes();
         self.faces.push(clamp);
-        Ok(nodes)
+        nodes
     }
 
     /// Applies the node conditions to grid velocities.

@@ -20,13 +20,9 @@ pub enum EngineError {
         source: KernelError,
     },
     /// The kernel could not evaluate the stencil at a face clamp's point (outside the
-    /// domain, or an ill-conditioned MLS system).
-    #[error("step {step}, face clamp {clamp}, face point {point}: {source}")]
+    /// domain, or an ill-conditioned MLS system), when the clamp was built.
+    #[error("face point {point}: {source}")]
     FacePoint {
-        /// Step number.
-        step: usize,
-        /// The clamp's position in [`crate::Boundary::faces`].
-        clamp: usize,
         /// The point's position in [`crate::FaceClamp::points`].
         point: usize,
         /// The kernel's error.

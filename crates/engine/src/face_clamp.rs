@@ -31,6 +31,9 @@
 //! face*).
 
 use nalgebra::{Cholesky, DMatrix, DVector, Dyn, SVector};
+use umls_transfer::{Kernel, Stencil};
+
+use crate::error::EngineError;
 
 /// Relative weight ε of the nodes' mass floor: a node without mass costs ε m̄ to change.
 pub const FACE_CLAMP_REGULARISATION: f64 = 1e-3;
@@ -40,27 +43,66 @@ pub const FACE_CLAMP_PENALTY: f64 = 1e4;
 
 /// A clamp held on its face: the velocity vanishes at `points` (where the body crosses
 /// the clamp's boundary), the clamp's other `nodes` are at rest.
+///
+/// The points do not move, so their stencils are evaluated once, when the clamp is
+/// built ([`FaceClamp::new`]); each step builds only the mass-weighted system.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FaceClamp<const D: usize> {
     nodes: Vec<u32>,
     points: Vec<SVector<f64, D>>,
+    /// Every node the points' stencils reach, sorted: the system's unknowns.
+    unknowns: Vec<u32>,
+    /// Each point's stencil as (position in `unknowns`, value) pairs.
+    rows: Vec<Vec<(usize, f64)>>,
     /// The weight W of the face points' residuals against the heaviest node's mass
     /// (default [`FACE_CLAMP_PENALTY`]).
     pub penalty: f64,
 }
 
 /// One face point's stencil: (node, value) pairs.
-pub(crate) type FaceRow = Vec<(u32, f64)>;
+type FaceRow = Vec<(u32, f64)>;
 
 impl<const D: usize> FaceClamp<D> {
-    /// A clamp whose region holds `nodes` and whose face is sampled at `points`.
-    /// Repeated nodes are merged.
-    pub fn new(mut nodes: Vec<u32>, points: Vec<SVector<f64, D>>) -> Self {
+    /// A clamp whose region holds `nodes` and whose face is sampled at `points`, with
+    /// the points' stencils evaluated by `kernel` (each from the kernel's default cache).
+    /// Repeated nodes are merged. Fails with the index of the first point the kernel
+    /// cannot evaluate (outside the domain, or an ill-conditioned fit).
+    pub fn new<K: Kernel<D>>(
+        kernel: &K,
+        nodes: Vec<u32>,
+        points: Vec<SVector<f64, D>>,
+    ) -> Result<Self, EngineError> {
+        let mut stencil = Stencil::new();
+        let mut rows = Vec::with_capacity(points.len());
+        for (point, x) in points.iter().enumerate() {
+            kernel
+                .stencil(x, &mut K::Cache::default(), &mut stencil)
+                .map_err(|source| EngineError::FacePoint { point, source })?;
+            rows.push(stencil.iter().map(|(n, v, _)| (n, v)).collect());
+        }
+        Ok(Self::from_rows(nodes, points, rows))
+    }
+
+    /// A clamp from the points' stencils `rows` (one per point).
+    fn from_rows(mut nodes: Vec<u32>, points: Vec<SVector<f64, D>>, rows: Vec<FaceRow>) -> Self {
         nodes.sort_unstable();
         nodes.dedup();
+        let mut unknowns: Vec<u32> = rows.iter().flatten().map(|e| e.0).collect();
+        unknowns.sort_unstable();
+        unknowns.dedup();
+        let rows = rows
+            .iter()
+            .map(|row| {
+                row.iter()
+                    .map(|&(n, c)| (unknowns.partition_point(|&u| u < n), c))
+                    .collect()
+            })
+            .collect();
         Self {
             nodes,
             points,
+            unknowns,
+            rows,
             penalty: FACE_CLAMP_PENALTY,
         }
     }
@@ -75,44 +117,46 @@ impl<const D: usize> FaceClamp<D> {
         &self.points
     }
 
-    /// This step's system from the face points' stencils `rows` and the nodal `mass`:
-    /// the unknowns (every node the rows reach) and the factorised normal matrix.
-    pub(crate) fn system(&self, rows: Vec<FaceRow>, mass: &[f64]) -> FaceSystem {
-        let mut unknowns: Vec<u32> = rows.iter().flatten().map(|e| e.0).collect();
-        unknowns.sort_unstable();
-        unknowns.dedup();
-        let k = unknowns.len();
-        let heaviest = unknowns
+    /// The nodes the constraint moves, sorted: the region's nodes and those of the face
+    /// points' stencils (a reaction set for the clamp).
+    pub fn moved_nodes(&self) -> Vec<u32> {
+        let mut nodes: Vec<u32> = self.nodes.iter().chain(&self.unknowns).copied().collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        nodes
+    }
+
+    /// This step's system from the nodal `mass`: the factorised normal matrix over the
+    /// unknowns.
+    pub(crate) fn system(&self, mass: &[f64]) -> FaceSystem {
+        let heaviest = self
+            .unknowns
             .iter()
             .map(|&n| mass[n as usize])
             .fold(0.0, f64::max);
         // Without mass anywhere near the face there is nothing to hold this step.
-        if k == 0 || heaviest <= 0.0 {
+        if self.unknowns.is_empty() || heaviest <= 0.0 {
             return FaceSystem {
-                unknowns,
                 weights: Vec::new(),
                 cholesky: None,
             };
         }
-        let weights: Vec<f64> = unknowns
+        let weights: Vec<f64> = self
+            .unknowns
             .iter()
             .map(|&n| mass[n as usize] + FACE_CLAMP_REGULARISATION * heaviest)
             .collect();
         let mut normal = DMatrix::<f64>::from_diagonal(&DVector::from_column_slice(&weights));
         let penalty = self.penalty * heaviest;
-        let mut local: Vec<(usize, f64)> = Vec::new();
-        for row in &rows {
-            local.clear();
-            local.extend(row.iter().map(|&(n, c)| (index(&unknowns, n), c)));
-            for &(a, ca) in &local {
-                for &(b, cb) in &local {
+        for row in &self.rows {
+            for &(a, ca) in row {
+                for &(b, cb) in row {
                     normal[(a, b)] += penalty * ca * cb;
                 }
             }
         }
         FaceSystem {
             cholesky: normal.cholesky(),
-            unknowns,
             weights,
         }
     }
@@ -122,7 +166,7 @@ impl<const D: usize> FaceClamp<D> {
     /// the face.
     pub(crate) fn hold(&self, system: &FaceSystem, velocity: &mut [SVector<f64, D>]) {
         // The targets: what the update gave, read before the region is set to rest.
-        let targets: Vec<SVector<f64, D>> = system
+        let targets: Vec<SVector<f64, D>> = self
             .unknowns
             .iter()
             .map(|&n| velocity[n as usize])
@@ -139,7 +183,7 @@ impl<const D: usize> FaceClamp<D> {
                 targets.iter().zip(&system.weights).map(|(t, w)| w * t[d]),
             );
             let x = cholesky.solve(&rhs);
-            for (j, &n) in system.unknowns.iter().enumerate() {
+            for (j, &n) in self.unknowns.iter().enumerate() {
                 velocity[n as usize][d] = x[j];
             }
         }
@@ -148,18 +192,11 @@ impl<const D: usize> FaceClamp<D> {
 
 /// One step's system of a [`FaceClamp`], shared by v, ṽ and the MUSL re-map.
 pub(crate) struct FaceSystem {
-    /// The nodes the face points' stencils reach, sorted.
-    unknowns: Vec<u32>,
-    /// Their weights m_u + ε m̄.
+    /// The unknowns' weights m_u + ε m̄.
     weights: Vec<f64>,
     /// The factorised normal matrix (`None` without unknowns or mass near the face, when
     /// the region's nodes are simply at rest).
     cholesky: Option<Cholesky<f64, Dyn>>,
-}
-
-/// The position of node `n` among the sorted `unknowns` (every row node is one).
-fn index(unknowns: &[u32], n: u32) -> usize {
-    unknowns.binary_search(&n).unwrap_or_default()
 }
 
 /// Points sampling the face where a body crosses a region's boundary: for every pair of
@@ -277,11 +314,11 @@ mod tests {
     /// A clamp with region nodes 0–2 and two face points whose stencils reach nodes 1–4,
     /// on nodes of unequal mass (node 5 untouched).
     fn clamp_and_rows() -> (FaceClamp<2>, Vec<FaceRow>, Vec<f64>) {
-        let clamp = FaceClamp::new(vec![2, 0, 1], vec![SVector::zeros(); 2]);
         let rows = vec![
             vec![(1, 0.3), (2, 0.5), (3, 0.2)],
             vec![(2, 0.1), (3, 0.6), (4, 0.3)],
         ];
+        let clamp = FaceClamp::from_rows(vec![2, 0, 1], vec![SVector::zeros(); 2], rows.clone());
         let mass = vec![1.0, 0.5, 2.0, 3.0, 0.0, 1.0];
         (clamp, rows, mass)
     }
@@ -292,7 +329,7 @@ mod tests {
     #[test]
     fn holding_the_face_moves_the_nodes_least_and_adds_no_energy() {
         let (clamp, rows, mass) = clamp_and_rows();
-        let system = clamp.system(rows.clone(), &mass);
+        let system = clamp.system(&mass);
         let before: Vec<SVector<f64, 2>> = (0..6)
             .map(|n| SVector::from([1.0 + n as f64, 0.5 - 0.3 * n as f64]))
             .collect();
@@ -347,12 +384,25 @@ mod tests {
         }
     }
 
+    /// The stencils' nodes are the unknowns, each row's entries found among them; the
+    /// moved nodes are those and the region's.
+    #[test]
+    fn the_moved_nodes_are_the_region_and_the_stencils() {
+        let (clamp, rows, _) = clamp_and_rows();
+        assert_eq!(clamp.moved_nodes(), vec![0, 1, 2, 3, 4]);
+        for (local, row) in clamp.rows.iter().zip(&rows) {
+            for (&(j, c), &(n, v)) in local.iter().zip(row) {
+                assert_eq!((clamp.unknowns[j], c), (n, v));
+            }
+        }
+    }
+
     /// With no mass near the face there is nothing to hold: the region is at rest and
     /// the other nodes keep their velocities.
     #[test]
     fn without_mass_near_the_face_only_the_region_is_at_rest() {
-        let (clamp, rows, _) = clamp_and_rows();
-        let system = clamp.system(rows, &[0.0; 6]);
+        let (clamp, _, _) = clamp_and_rows();
+        let system = clamp.system(&[0.0; 6]);
         let mut v = vec![SVector::from([1.0, 2.0]); 6];
         clamp.hold(&system, &mut v);
         assert!(v[..3].iter().all(|v| *v == SVector::<f64, 2>::zeros()));

@@ -10,7 +10,9 @@
 
 use nalgebra::{SVector, Vector2};
 use umls_constitutive::{ElasticParameters, NeoHookean};
-use umls_engine::{FaceClamp, Flip, Simulation, StepSettings, StressUpdate, face_points};
+use umls_engine::{
+    EngineError, FaceClamp, Flip, Simulation, StepSettings, StressUpdate, face_points,
+};
 use umls_kernels::Umls2;
 use umls_transfer::{Kernel, Stencil};
 
@@ -79,8 +81,8 @@ fn run_with(
             nodes
         }
         Clamp::Face => {
-            let face = FaceClamp::new(nodes, points.clone());
-            sim.boundary.add_face_clamp(&sim.kernel, face).unwrap()
+            let face = FaceClamp::new(&sim.kernel, nodes, points.clone()).unwrap();
+            sim.boundary.add_face_clamp(face)
         }
     };
     sim.boundary.reaction_sets.push(reaction_nodes);
@@ -218,12 +220,12 @@ fn face_points_sample_the_face_where_the_body_crosses_it() {
 /// A face point the kernel cannot evaluate (outside the mesh) is named by its index.
 #[test]
 fn a_face_point_outside_the_mesh_is_named() {
-    let mut boundary = umls_engine::Boundary::<2>::default();
     let kernel = Umls2::new(mesh(0.0, 0.0));
     let points = vec![Vector2::new(0.0, 0.2), Vector2::new(9.0, 0.2)];
-    let error = boundary
-        .add_face_clamp(&kernel, FaceClamp::new(vec![0], points))
-        .unwrap_err();
-    assert_eq!(error.0, 1);
-    assert!(boundary.faces.is_empty());
+    let error = FaceClamp::new(&kernel, vec![0], points).unwrap_err();
+    assert!(
+        matches!(error, EngineError::FacePoint { point: 1, .. }),
+        "{error}"
+    );
+    assert!(error.to_string().starts_with("face point 1: "), "{error}");
 }

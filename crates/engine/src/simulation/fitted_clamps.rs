@@ -11,7 +11,6 @@ use umls_transfer::{Kernel, Stencil};
 
 use super::Simulation;
 use crate::error::EngineError;
-use crate::face_clamp::FaceRow;
 use crate::fitted_clamp::ClampRow;
 use crate::transfer::TransferScheme;
 
@@ -28,40 +27,14 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             clamp.fit(&system, &mut self.grid.new_velocity);
             self.clamp_systems.push(system);
         }
-        let rows = self.face_rows()?;
         self.face_systems.clear();
-        for (clamp, rows) in self.boundary.faces.iter().zip(rows) {
-            let system = clamp.system(rows, &self.grid.mass);
+        for clamp in &self.boundary.faces {
+            let system = clamp.system(&self.grid.mass);
             clamp.hold(&system, &mut self.grid.velocity);
             clamp.hold(&system, &mut self.grid.new_velocity);
             self.face_systems.push(system);
         }
         Ok(())
-    }
-
-    /// The face points' stencils, one list per face clamp. The points do not move, and
-    /// each is located afresh from the kernel's default cache, so every step gives the
-    /// same stencils.
-    fn face_rows(&self) -> Result<Vec<Vec<FaceRow>>, EngineError> {
-        let mut scratch = Stencil::new();
-        let mut all = Vec::with_capacity(self.boundary.faces.len());
-        for (clamp, face) in self.boundary.faces.iter().enumerate() {
-            let mut rows = Vec::with_capacity(face.points().len());
-            for (point, x) in face.points().iter().enumerate() {
-                let mut cache = K::Cache::default();
-                self.kernel
-                    .stencil(x, &mut cache, &mut scratch)
-                    .map_err(|source| EngineError::FacePoint {
-                        step: self.step,
-                        clamp,
-                        point,
-                        source,
-                    })?;
-                rows.push(scratch.iter().map(|(n, v, _)| (n, v)).collect());
-            }
-            all.push(rows);
-        }
-        Ok(all)
     }
 
     /// The clamped particles' stencils of this step, one list per clamp.
