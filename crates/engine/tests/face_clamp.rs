@@ -14,21 +14,17 @@ use umls_engine::{
     EngineError, FaceClamp, Flip, Simulation, StepSettings, StressUpdate, face_points,
 };
 use umls_kernels::Umls2;
-use umls_transfer::{Kernel, Stencil};
+use umls_transfer::Kernel;
 
 #[path = "common/clamped_beam.rs"]
 mod clamped_beam;
 use clamped_beam::{beam, mesh};
+#[path = "common/face_hold.rs"]
+mod face_hold;
+use face_hold::{Clamp, layout_spreads};
 
 /// The particle on the free end's centre line (x = 2.4375, y = 0.1875).
 const TIP: usize = 23 * 4 + 1;
-
-/// How the clamp region x ≤ 0 is imposed.
-#[derive(Clone, Copy, PartialEq, Debug)]
-enum Clamp {
-    Nodes,
-    Face,
-}
 
 /// What a run measured.
 struct Outcome {
@@ -89,24 +85,11 @@ fn run_with(
     sim.settings.measure_reactions = true;
     let mut impulse = SVector::<f64, 2>::zeros();
     let (mut deepest, mut face_speed) = (0.0f64, 0.0f64);
-    let mut stencil = Stencil::new();
     while sim.time() < duration {
         sim.step().unwrap();
         impulse += sim.reactions()[0].force * sim.last_dt();
-        let p = sim.particles();
-        deepest = deepest.min(p.position[TIP].y - start[TIP].y);
-        let fastest = p.velocity.iter().map(|v| v.norm()).fold(0.0, f64::max);
-        let (_, grid_velocity) = sim.grid();
-        for x in &points {
-            sim.kernel
-                .stencil(x, &mut Default::default(), &mut stencil)
-                .unwrap();
-            let v: SVector<f64, 2> = stencil
-                .iter()
-                .map(|(n, value, _)| grid_velocity[n as usize] * value)
-                .sum();
-            face_speed = face_speed.max(v.norm() / fastest);
-        }
+        deepest = deepest.min(sim.particles().position[TIP].y - start[TIP].y);
+        face_speed = face_speed.max(face_hold::face_speed(&sim, &points));
     }
     let d = sim.diagnostics().unwrap();
     let gravity = sim.settings.gravity * d.mass * sim.time();
@@ -124,18 +107,7 @@ fn run_with(
 /// fixed nodes), face clamp −0.344 / −0.344 / −0.351 / −0.365.
 #[test]
 fn the_face_clamp_ends_the_beam_at_the_face_wherever_the_nodes_lie() {
-    let spread = |clamp| {
-        let deepest: Vec<f64> = [0.0, 0.25, 0.5, 0.75]
-            .iter()
-            .map(|&shift| run(shift, 0.0, clamp, 0.99, 0.45).deepest)
-            .collect();
-        let (low, high) = deepest
-            .iter()
-            .fold((f64::MAX, f64::MIN), |(l, h), &d| (l.min(d), h.max(d)));
-        (high - low) / high.abs()
-    };
-    let nodes = spread(Clamp::Nodes);
-    let face = spread(Clamp::Face);
+    let (nodes, face) = layout_spreads(|shift, clamp| run(shift, 0.0, clamp, 0.99, 0.45).deepest);
     assert!(nodes > 0.25, "node clamp spread {nodes}");
     assert!(face < 0.07, "face clamp spread {face}");
 }

@@ -8,13 +8,17 @@
 
 use std::sync::Arc;
 
-use nalgebra::{SVector, Vector3};
+use nalgebra::Vector3;
 use umls_constitutive::{ElasticParameters, NeoHookean};
 use umls_engine::{FaceClamp, Flip, Particles, Simulation, StepSettings, face_points};
 use umls_kernels::{HostCache, Umls3};
 use umls_mesh::SimplexMesh;
 use umls_mesh::generate::Lattice;
-use umls_transfer::{Kernel, Stencil};
+use umls_transfer::Kernel;
+
+#[path = "common/face_hold.rs"]
+mod face_hold;
+use face_hold::{Clamp, layout_spreads};
 
 /// Cell size of the lattices.
 const H: f64 = 0.25;
@@ -53,13 +57,6 @@ fn beam() -> Particles<3, (), HostCache<3>> {
     Particles::at_rest(x, vec![SPACING.powi(3); n], 1000.0, ())
 }
 
-/// How the clamp region x ≤ 0 is imposed.
-#[derive(Clone, Copy, PartialEq, Debug)]
-enum Clamp {
-    Nodes,
-    Face,
-}
-
 /// What a run measured.
 struct Outcome {
     /// The tip particle's lowest displacement along y.
@@ -96,37 +93,15 @@ fn run(shift: f64, angle: f64, clamp: Clamp, duration: f64) -> Outcome {
         }
     }
     let (mut deepest, mut face_speed) = (0.0f64, 0.0f64);
-    let mut stencil = Stencil::new();
     while sim.time() < duration {
         sim.step().unwrap();
-        let p = sim.particles();
-        deepest = deepest.min(p.position[TIP].y - start[TIP].y);
-        let fastest = p.velocity.iter().map(|v| v.norm()).fold(0.0, f64::max);
-        let (_, grid_velocity) = sim.grid();
-        for x in &points {
-            sim.kernel
-                .stencil(x, &mut Default::default(), &mut stencil)
-                .unwrap();
-            let v: SVector<f64, 3> = stencil
-                .iter()
-                .map(|(n, value, _)| grid_velocity[n as usize] * value)
-                .sum();
-            face_speed = face_speed.max(v.norm() / fastest);
-        }
+        deepest = deepest.min(sim.particles().position[TIP].y - start[TIP].y);
+        face_speed = face_speed.max(face_hold::face_speed(&sim, &points));
     }
     Outcome {
         deepest,
         face_speed,
     }
-}
-
-/// The relative spread (largest less smallest over the largest in size) of the deepest
-/// tip displacements.
-fn spread(deepest: &[f64]) -> f64 {
-    let (low, high) = deepest
-        .iter()
-        .fold((f64::MAX, f64::MIN), |(l, h), &d| (l.min(d), h.max(d)));
-    (high - low) / high.abs()
 }
 
 /// The deepest tip displacement over the first swing, on the lattice moved by 0, ¼, ½
@@ -137,14 +112,7 @@ fn spread(deepest: &[f64]) -> f64 {
 /// 2 × 0.234 from rest: the layout test, not the deflection, is what this asserts.)
 #[test]
 fn the_face_clamp_ends_the_beam_at_the_face_wherever_the_tetrahedra_lie() {
-    let deepest = |clamp| -> Vec<f64> {
-        [0.0, 0.25, 0.5, 0.75]
-            .iter()
-            .map(|&shift| run(shift, 0.0, clamp, 0.45).deepest)
-            .collect()
-    };
-    let nodes = spread(&deepest(Clamp::Nodes));
-    let face = spread(&deepest(Clamp::Face));
+    let (nodes, face) = layout_spreads(|shift, clamp| run(shift, 0.0, clamp, 0.45).deepest);
     assert!(nodes > 0.2, "node clamp spread {nodes}");
     assert!(face < 0.05, "face clamp spread {face}");
 }
