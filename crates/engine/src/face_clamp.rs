@@ -66,7 +66,8 @@ impl<const D: usize> FaceClamp<D> {
     /// A clamp whose region holds `nodes` and whose face is sampled at `points`, with
     /// the points' stencils evaluated by `kernel` (each from the kernel's default cache).
     /// Repeated nodes are merged. Fails with the index of the first point the kernel
-    /// cannot evaluate (outside the domain, or an ill-conditioned fit).
+    /// cannot evaluate (outside the domain, or an ill-conditioned fit). The clamp keeps
+    /// `kernel`'s node numbers: a simulation with another kernel refuses it at its step.
     pub fn new<K: Kernel<D>>(
         kernel: &K,
         nodes: Vec<u32>,
@@ -124,6 +125,11 @@ impl<const D: usize> FaceClamp<D> {
         nodes.sort_unstable();
         nodes.dedup();
         nodes
+    }
+
+    /// The largest node number the clamp holds or moves (`None` without any).
+    pub(crate) fn largest_node(&self) -> Option<u32> {
+        self.nodes.last().max(self.unknowns.last()).copied()
     }
 
     /// This step's system from the nodal `mass`: the factorised normal matrix over the

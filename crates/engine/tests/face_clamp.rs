@@ -8,12 +8,15 @@
 //!   reactions account for every impulse the constraint adds.
 //! - A face point outside the mesh is named.
 
+use std::sync::Arc;
+
 use nalgebra::{SVector, Vector2};
 use umls_constitutive::{ElasticParameters, NeoHookean};
 use umls_engine::{
     EngineError, FaceClamp, Flip, Simulation, StepSettings, StressUpdate, face_points,
 };
 use umls_kernels::Umls2;
+use umls_mesh::generate::{Diagonal, Lattice};
 use umls_transfer::Kernel;
 
 #[path = "common/clamped_beam.rs"]
@@ -200,4 +203,41 @@ fn a_face_point_outside_the_mesh_is_named() {
         "{error}"
     );
     assert!(error.to_string().starts_with("face point 1: "), "{error}");
+}
+
+/// A clamp keeps the node numbers of the kernel that built it: given to a simulation on
+/// a smaller mesh, whose nodes those are not, the step refuses it instead of indexing
+/// past the grid.
+#[test]
+fn a_clamp_built_with_another_kernel_is_refused() {
+    let large = Umls2::new(mesh(0.0, 0.0));
+    let clamp = FaceClamp::new(&large, vec![0], vec![Vector2::new(3.0, 0.2)]).unwrap();
+    let small = Arc::new(
+        Lattice::new([-1.0, -1.0], [3.0, 1.0], [4, 2])
+            .triangles(Diagonal::Alternating)
+            .unwrap(),
+    );
+    let material = NeoHookean {
+        parameters: ElasticParameters::from_young_poisson(1e7, 0.3).unwrap(),
+    };
+    let mut sim = Simulation::new(
+        Umls2::new(small),
+        material,
+        Flip { alpha: 0.99 },
+        beam(),
+        StepSettings::new(1e-4),
+    )
+    .unwrap();
+    sim.boundary.add_face_clamp(clamp);
+    let error = sim.step().unwrap_err();
+    assert!(
+        matches!(
+            error,
+            EngineError::InvalidParameter {
+                parameter: "face clamp node",
+                ..
+            }
+        ),
+        "{error}"
+    );
 }

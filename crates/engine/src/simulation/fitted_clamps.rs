@@ -29,6 +29,16 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         }
         self.face_systems.clear();
         for clamp in &self.boundary.faces {
+            if let Some(node) = clamp
+                .largest_node()
+                .filter(|&n| n as usize >= self.grid.mass.len())
+            {
+                return Err(EngineError::InvalidParameter {
+                    parameter: "face clamp node",
+                    value: node as f64,
+                    reason: "names a node beyond the kernel's node count (a clamp built with another kernel)",
+                });
+            }
             let system = clamp.system(&self.grid.mass);
             clamp.hold(&system, &mut self.grid.velocity);
             clamp.hold(&system, &mut self.grid.new_velocity);
