@@ -621,10 +621,11 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             self.reactions.1.clear();
             self.reactions.0.nodal.clear();
         }
-        // Fitted clamps change node velocities after the update, so with them the
-        // reactions are taken around both.
-        let fitted = !self.boundary.fitted.is_empty() || !self.boundary.faces.is_empty();
-        if measure && fitted {
+        // Fitted and face clamps change node velocities after the update, so with them
+        // the reactions are taken around both.
+        let clamps_after_update =
+            !self.boundary.fitted.is_empty() || !self.boundary.faces.is_empty();
+        if measure && clamps_after_update {
             self.reactions
                 .0
                 .record(&self.boundary, &self.grid.momentum, &self.grid.force, dt);
@@ -638,10 +639,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             self.settings.cancellation_fraction,
             self.settings.damping,
             &self.boundary,
-            (measure && !fitted).then_some(&mut self.reactions),
+            (measure && !clamps_after_update).then_some(&mut self.reactions),
         );
-        self.apply_fitted_clamps()?;
-        if measure && fitted {
+        self.apply_clamps_after_update()?;
+        if measure && clamps_after_update {
             let (scratch, out) = &mut self.reactions;
             scratch.reactions(
                 &self.boundary,

@@ -241,3 +241,38 @@ fn a_clamp_built_with_another_kernel_is_refused() {
         "{error}"
     );
 }
+
+/// A penalty that is not a positive number is refused at the step: zero would hold
+/// nothing, a negative or NaN one can leave the normal matrix without a Cholesky factor,
+/// and either way the face would go unheld without a word.
+#[test]
+fn a_face_clamp_without_a_positive_penalty_is_refused() {
+    for penalty in [0.0, -1e4, f64::NAN] {
+        let kernel = Umls2::new(mesh(0.0, 0.0));
+        let start = beam().position;
+        let nodes: Vec<u32> = (0..kernel.node_count() as u32)
+            .filter(|&n| kernel.node_position(n as usize).x <= 0.0)
+            .collect();
+        let points = face_points(&start, |x| x.x <= 0.0, 1.5 * 0.125);
+        let mut clamp = FaceClamp::new(&kernel, nodes, points).unwrap();
+        clamp.penalty = penalty;
+        let material = NeoHookean {
+            parameters: ElasticParameters::from_young_poisson(1e7, 0.3).unwrap(),
+        };
+        let settings = StepSettings::new(1e-4);
+        let mut sim =
+            Simulation::new(kernel, material, Flip { alpha: 0.99 }, beam(), settings).unwrap();
+        sim.boundary.add_face_clamp(clamp);
+        let error = sim.step().unwrap_err();
+        assert!(
+            matches!(
+                error,
+                EngineError::InvalidParameter {
+                    parameter: "face clamp penalty",
+                    ..
+                }
+            ),
+            "penalty {penalty}: {error}"
+        );
+    }
+}

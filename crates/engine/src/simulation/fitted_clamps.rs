@@ -15,10 +15,10 @@ use crate::fitted_clamp::ClampRow;
 use crate::transfer::TransferScheme;
 
 impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
-    /// Builds this step's clamp systems (kept for the MUSL re-map) and fits the clamps'
-    /// nodes in the grid velocities before and after the update (so a FLIP increment
-    /// vanishes at the clamped particles as well as the velocity).
-    pub(super) fn apply_fitted_clamps(&mut self) -> Result<(), EngineError> {
+    /// Builds this step's systems of the fitted and the face clamps (kept for the MUSL
+    /// re-map) and applies them to the grid velocities before and after the update (so a
+    /// FLIP increment vanishes where the clamp holds, as well as the velocity).
+    pub(super) fn apply_clamps_after_update(&mut self) -> Result<(), EngineError> {
         let rows = self.fitted_clamp_rows()?;
         self.clamp_systems.clear();
         for (clamp, rows) in self.boundary.fitted.iter().zip(rows) {
@@ -37,6 +37,15 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     parameter: "face clamp node",
                     value: node as f64,
                     reason: "names a node beyond the kernel's node count (a clamp built with another kernel)",
+                });
+            }
+            if !(clamp.penalty.is_finite() && clamp.penalty > 0.0) {
+                // Zero would hold nothing, a negative penalty can leave the normal matrix
+                // without a Cholesky factor: either way the face silently unheld.
+                return Err(EngineError::InvalidParameter {
+                    parameter: "face clamp penalty",
+                    value: clamp.penalty,
+                    reason: "must be finite and positive",
                 });
             }
             let system = clamp.system(&self.grid.mass);
