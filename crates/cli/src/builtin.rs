@@ -13,7 +13,7 @@ pub struct Builtin {
 }
 
 /// Every built-in scene.
-pub const BUILTIN: [Builtin; 14] = [
+pub const BUILTIN: [Builtin; 15] = [
     Builtin {
         name: "colliding-disks",
         summary: "two elastic disks collide and rebound (Sulsky et al. 1994) on a jittered triangle mesh",
@@ -63,6 +63,11 @@ pub const BUILTIN: [Builtin; 14] = [
         name: "cantilever",
         summary: "the UMLS paper's cantilever (4 × 1 neo-Hookean beam, embedded clamp) on a lattice the scene can turn, against a converged tip history",
         toml: include_str!("../../../scenes/cantilever.toml"),
+    },
+    Builtin {
+        name: "cantilever-3d",
+        summary: "a 3 × 0.5 × 0.5 neo-Hookean beam held on the face of an embedded clamp, on Kuhn tetrahedra, over its first swing",
+        toml: include_str!("../../../scenes/cantilever-3d.toml"),
     },
     Builtin {
         name: "cantilever-unstructured",
