@@ -4,12 +4,14 @@
 //! same at every angle within the paper's 5 %. In 3D the built-in `cantilever-3d` beam on
 //! Kuhn tetrahedra swings alike wherever the lattice lies under it.
 
+use umls_cli::edit::override_text;
 use umls_cli::run::run;
+use umls_cli::scene::Scene;
 use umls_cli::schema::KernelKind;
 
 #[path = "common/runs.rs"]
 mod runs;
-use runs::{History, options, variant};
+use runs::{History, options, variant, variant_text};
 
 /// The largest |u| of the reference tip history over t ≤ `end`.
 fn reference_scale(end: f64) -> f64 {
@@ -103,20 +105,16 @@ fn on_the_unstructured_mesh_the_face_clamp_turns_with_the_mesh_within_five_perce
 /// u_y at the free end over its first swing (t ≤ 0.45).
 fn deepest_3d_tip(shift: f64, imposed: &str) -> f64 {
     let dx = shift * 0.25;
-    let lower = format!("lower = [{}, -2.0, -0.5]", -1.5 - dx);
-    let upper = format!("upper = [{}, 1.5, 1.0]", 3.5 - dx);
-    let scene = variant(
-        "cantilever-3d",
-        &[
-            ("lower = [-1.5, -2.0, -0.5]", &lower),
-            ("upper = [3.5, 1.5, 1.0]", &upper),
-            // The line in [[boundaries]], not the header comment's mention of it.
-            (
-                "imposed = \"face\"\nregion",
-                &format!("imposed = \"{imposed}\"\nregion"),
-            ),
-        ],
-    );
+    // Edited by key, as `--set` does: a text match could hit the header's comments.
+    let edits = [
+        ("mesh.lattice.lower", format!("[{}, -2.0, -0.5]", -1.5 - dx)),
+        ("mesh.lattice.upper", format!("[{}, 1.5, 1.0]", 3.5 - dx)),
+        ("boundaries.0.imposed", format!("\"{imposed}\"")),
+    ]
+    .map(|(key, value)| (key.to_string(), value));
+    let text = variant_text("cantilever-3d", &[]);
+    let text = override_text(&text, "cantilever-3d", &edits).unwrap();
+    let scene = Scene::parse(&text, "cantilever-3d", None).unwrap();
     let out = options(&format!("face-clamp-3d-{shift}-{imposed}"), None, None);
     run(&scene, &out).unwrap();
     let history = History::read(&out.out);
