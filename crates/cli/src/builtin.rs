@@ -93,7 +93,7 @@ pub const BUILTIN: [Builtin; 15] = [
 
 /// Files the built-in scenes refer to (meshes, reference data), by the name the scene
 /// uses.
-pub const FILES: [(&str, &[u8]); 7] = [
+pub const FILES: [(&str, &[u8]); 8] = [
     (
         "meshes/cantilever.msh",
         include_bytes!("../../../scenes/meshes/cantilever.msh"),
@@ -121,5 +121,9 @@ pub const FILES: [(&str, &[u8]); 7] = [
     (
         "data/cantilever-tip.csv",
         include_bytes!("../../../scenes/data/cantilever-tip.csv"),
+    ),
+    (
+        "data/cantilever-3d-tip.csv",
+        include_bytes!("../../../scenes/data/cantilever-3d-tip.csv"),
     ),
 ];

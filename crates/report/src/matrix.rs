@@ -15,7 +15,7 @@ use serde::Deserialize;
 
 use crate::error::{ReportError, Result};
 
-/// The built-in matrices: `quick` (coarse levels, 741 runs, about 30 minutes on 2 cores)
+/// The built-in matrices: `quick` (coarse levels, 761 runs, about 30 minutes on 2 cores)
 /// and `full`.
 pub const BUILTIN: [(&str, &str); 2] = [
     ("quick", include_str!("../matrices/quick.toml")),
