@@ -3,9 +3,9 @@
 # scenes/cantilever-3d.toml: the same scene refined 9 times (Kuhn cells 0.25/9,
 # particles 0.125/9 apart, 279,936 of them; every odd refinement keeps a particle at the
 # probe (2.4375, 0.1875, 0.1875)) run with quadratic B-splines, which do not depend on
-# the tetrahedra, held on the clamp's face as the scene is. About 20 minutes on two
-# cores. The run writes a row every step (about 8,900); every fourth is kept, which
-# leaves linear interpolation between rows below 10^-5 of the deflection.
+# the tetrahedra, held on the clamp's face as the scene is. About 30 minutes on two
+# cores. The run writes a row every step (6,266 of them); every fourth is kept, which
+# leaves linear interpolation between rows below 10^-6 of the deflection.
 # Run from the repository root:
 #   sh scenes/data/make_cantilever_3d_reference.sh [KERNEL] [REFINE]
 set -e

@@ -5,14 +5,14 @@
 //! Kuhn tetrahedra swings alike wherever the lattice lies under it, and converges to its
 //! reference history under refinement.
 
-use umls_cli::edit::{override_text, refine};
+use umls_cli::edit::refine;
 use umls_cli::run::run;
 use umls_cli::scene::Scene;
 use umls_cli::schema::KernelKind;
 
 #[path = "common/runs.rs"]
 mod runs;
-use runs::{History, metric, options, variant, variant_text};
+use runs::{History, metric, options, variant};
 
 /// The largest |u| of the reference tip history over t ≤ `end`.
 fn reference_scale(end: f64) -> f64 {
@@ -113,9 +113,7 @@ fn deepest_3d_tip(shift: f64, imposed: &str) -> f64 {
         ("boundaries.0.imposed", format!("\"{imposed}\"")),
     ]
     .map(|(key, value)| (key.to_string(), value));
-    let text = variant_text("cantilever-3d", &[]);
-    let text = override_text(&text, "cantilever-3d", &edits).unwrap();
-    let scene = Scene::parse(&text, "cantilever-3d", None).unwrap();
+    let scene = Scene::load_with("cantilever-3d", &edits).unwrap();
     let out = options(&format!("face-clamp-3d-{shift}-{imposed}"), None, None);
     run(&scene, &out).unwrap();
     let history = History::read(&out.out);
