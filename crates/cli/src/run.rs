@@ -504,11 +504,11 @@ fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
             start(ctx, kernel, table, AffineTransfer::VelocityGradient)
         }
         TransferKind::MlsMpm => {
-            if kernel.constant_second_moment().is_none() {
+            if !kernel.regular_second_moment() {
                 return Err(ctx.scene.value_error(
                     "transfer.kind",
-                    "mls-mpm folds the force into the affine term with one constant D_p: \
-                     it needs a B-spline kernel (bspline2, bspline3)",
+                    "mls-mpm takes D_p⁻¹ N_i (x_i − x_p) as the force's gradient, and linear \
+                     elements' D_p vanishes at the vertices: it needs a B-spline or UMLS kernel",
                 ));
             }
             start(ctx, kernel, table, MlsMpm)

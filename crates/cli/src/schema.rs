@@ -433,7 +433,8 @@ pub enum TransferKind {
     /// Affine transfer with C = ∇v.
     VelocityGradient,
     /// MLS-MPM: APIC with the force folded into the affine momentum and ∇v = C (Hu et
-    /// al. 2018, Taichi's scheme); B-spline kernels only.
+    /// al. 2018, Taichi's scheme); B-spline and UMLS kernels (UMLS with each particle's
+    /// own D_p), not linear elements.
     MlsMpm,
 }
 

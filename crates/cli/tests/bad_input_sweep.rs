@@ -172,10 +172,12 @@ fn bad_command_lines_fail_with_usage() {
             "transfer.alpha",
         ),
         (
-            // MLS-MPM needs a B-spline kernel; the disks run UMLS.
+            // MLS-MPM needs D_p⁻¹, which linear elements do not have at their vertices.
             vec![
                 "run",
                 "colliding-disks",
+                "--kernel",
+                "linear-fe",
                 "--set",
                 "transfer.kind=mls-mpm",
                 "--out",

@@ -40,9 +40,10 @@ mod tensor_rows;
 pub type BodyForce<const D: usize> =
     std::sync::Arc<dyn Fn(usize, &SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync>;
 
-/// Refuses what a fused-force transfer (MLS-MPM) cannot do: its D_p⁻¹ must be one
-/// constant (B-splines), and with no separate nodal force neither damping nor MUSL's
-/// re-mapped gradient would act as they say.
+/// Refuses what a fused-force transfer (MLS-MPM) cannot do: its D_p⁻¹ must exist
+/// (B-splines' constant one, or an MLS fit's per particle; not linear elements', which
+/// vanishes at the vertices), and with no separate nodal force neither damping nor
+/// MUSL's re-mapped gradient would act as they say.
 fn check_transfer<const D: usize, K: Kernel<D>, T: TransferScheme>(
     transfer: &T,
     kernel: &K,
@@ -58,10 +59,10 @@ fn check_transfer<const D: usize, K: Kernel<D>, T: TransferScheme>(
             reason,
         })
     };
-    if kernel.constant_second_moment().is_none() {
+    if !kernel.regular_second_moment() {
         return unsupported(
-            "a kernel whose second moment D_p varies (mesh kernels)",
-            "its force uses ∇N_i = D⁻¹ N_i (x_i − x_p) with one constant D (B-splines)",
+            "a kernel whose second moment D_p can vanish (linear elements)",
+            "its force uses ∇N_i = D_p⁻¹ N_i (x_i − x_p), which needs D_p positive definite",
         );
     }
     if settings.damping != crate::settings::Damping::None {
@@ -598,7 +599,10 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             .compute(
                 &self.kernel,
                 storage,
-                T::AFFINE && self.kernel.constant_second_moment().is_none(),
+                (
+                    T::AFFINE && self.kernel.constant_second_moment().is_none(),
+                    !T::FUSED_FORCE,
+                ),
                 &self.particles.position,
                 &mut self.particles.cache,
             )

@@ -184,14 +184,15 @@ impl<const D: usize> Stencils<D> {
     /// Locates every particle (updating its cache) and stores its stencil (entries or
     /// factors), or with recomputed stencils only its node range. With `moments`, stored
     /// entries come with each particle's second moment D_p
-    /// ([`Self::stored_second_moment`]), and under a kernel's integration correction with
-    /// each particle's ξ̄_p ([`Self::stored_correction_mean`]). Among failures the lowest
-    /// particle index is reported, whatever the thread count.
+    /// ([`Self::stored_second_moment`]), and with `corrected` under a kernel's
+    /// integration correction with each particle's ξ̄_p ([`Self::stored_correction_mean`];
+    /// MLS-MPM, whose force gradient is not the kernel's, does not read it). Among
+    /// failures the lowest particle index is reported, whatever the thread count.
     pub fn compute<K: Kernel<D>>(
         &mut self,
         kernel: &K,
         storage: StencilStorage,
-        moments: bool,
+        (moments, corrected): (bool, bool),
         positions: &[SVector<f64, D>],
         caches: &mut [K::Cache],
     ) -> Result<(), (usize, KernelError)> {
@@ -207,7 +208,7 @@ impl<const D: usize> Stencils<D> {
             self.mode = Mode::EntriesWithMoments;
         }
         let mode = self.mode;
-        let correction = kernel.force_gradient_correction();
+        let correction = kernel.force_gradient_correction().filter(|_| corrected);
         self.chunks
             .resize_with(positions.len().div_ceil(CHUNK), ChunkStencils::default);
         self.ranges.resize(positions.len(), (0, 0));

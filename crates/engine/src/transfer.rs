@@ -20,10 +20,11 @@ pub trait TransferScheme: Copy + Send + Sync + std::fmt::Debug {
     /// 2018): ∇N_i is taken as D_p⁻¹ N_i (x_i − x_p), so the stress impulse
     /// −Δt V τ ∇N_i joins the term P2G spreads anyway, N_i (m C − Δt V τ D_p⁻¹)(x_i − x_p),
     /// and gravity joins the momentum: no per-node gradient, force or stiffness, and G2P
-    /// takes ∇v = C_p. Needs a constant D_p (B-splines); the grid update then sees no
-    /// separate force, so damping and selective mass scaling do not act, and MUSL's
-    /// re-mapped gradient would be another scheme ([`crate::Simulation::new`] refuses
-    /// those combinations).
+    /// takes ∇v = C_p. Needs D_p⁻¹: B-splines' constant one, or each particle's own
+    /// where the kernel's D_p stays regular (MLS fits; `Kernel::regular_second_moment`);
+    /// the grid update then sees no separate force, so damping and selective mass
+    /// scaling do not act, and MUSL's re-mapped gradient would be another scheme
+    /// ([`crate::Simulation::new`] refuses those combinations).
     const FUSED_FORCE: bool = false;
 
     /// Whether the particles carry quadratic velocity modes besides C_p
@@ -97,7 +98,11 @@ pub struct Apic;
 /// internal force folded into the affine momentum ([`TransferScheme::FUSED_FORCE`]) and
 /// ∇v = C_p. For quadratic B-splines D_p⁻¹ N_i (x_i − x_p) is an O(h) approximation of
 /// ∇N_i (exact for linear velocity fields), so results differ from APIC's at that order
-/// for about half the per-node arithmetic.
+/// for about half the per-node arithmetic. With an MLS kernel (UMLS) D_p is each
+/// particle's own, summed with its stencil: the gradient D_p⁻¹ N_i (x_i − x_p) is then
+/// as continuous as N_i and D_p (across facets too) and still exact for linear fields
+/// (Σ N_i r_i = 0 and Σ N_i r_i r_iᵀ = D_p), but it is not the kernel's reconstructed
+/// gradient, so the kernel's integration correction does not enter either.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct MlsMpm;
 
@@ -177,15 +182,10 @@ impl TransferScheme for Apic {
         d: &SMatrix<f64, D, D>,
         grad_v: &SMatrix<f64, D, D>,
     ) -> SMatrix<f64, D, D> {
-        let Some(cholesky) = d.cholesky() else {
-            return *grad_v;
-        };
-        let scale = (d.trace() / D as f64).powi(D as i32);
-        let det = cholesky.l_dirty().diagonal().product().powi(2);
-        if det.is_nan() || det <= 1e-6 * scale {
-            return *grad_v;
+        match regular_inverse(d) {
+            Some(inverse) => b * inverse,
+            None => *grad_v,
         }
-        b * cholesky.inverse()
     }
 
     #[inline]
@@ -197,6 +197,53 @@ impl TransferScheme for Apic {
     ) -> SMatrix<f64, D, D> {
         // D_p = s I with s > 0 (a B-spline's variance): C_p = B_p / s, the closed form.
         b / s
+    }
+}
+
+/// D⁻¹ of a second moment that is positive definite (Cholesky succeeds) and not near
+/// singular (det D > 10⁻⁶ (tr D / D)^D); `None` otherwise. APIC falls back to the
+/// velocity gradient there, and MLS-MPM, whose gradient is D⁻¹ N_i (x_i − x_p), reports
+/// the particle ([`SingularSecondMoment`]).
+#[inline]
+pub(crate) fn regular_inverse<const D: usize>(
+    d: &SMatrix<f64, D, D>,
+) -> Option<SMatrix<f64, D, D>> {
+    let cholesky = d.cholesky()?;
+    let scale = (d.trace() / D as f64).powi(D as i32);
+    let det = cholesky.l_dirty().diagonal().product().powi(2);
+    if det.is_nan() || det <= 1e-6 * scale {
+        return None;
+    }
+    Some(cholesky.inverse())
+}
+
+/// A particle's second moment D_p that MLS-MPM cannot invert (see [`regular_inverse`]),
+/// reported as the cause of a [`umls_transfer::KernelError::Evaluation`] with the
+/// particle and step ([`crate::EngineError::Kernel`]).
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error(
+    "the particle's second moment D_p (determinant {determinant:e}, trace {trace:e}) is not \
+     positive definite or is near singular, and MLS-MPM's gradient D_p⁻¹ N_i (x_i − x_p) \
+     needs its inverse"
+)]
+pub struct SingularSecondMoment {
+    /// det D_p.
+    pub determinant: f64,
+    /// tr D_p.
+    pub trace: f64,
+}
+
+impl SingularSecondMoment {
+    /// The error for `d`, as the kernel `K`'s evaluation error.
+    #[cold]
+    pub(crate) fn of<const D: usize, K>(d: &SMatrix<f64, D, D>) -> umls_transfer::KernelError {
+        umls_transfer::KernelError::evaluation(
+            std::any::type_name::<K>(),
+            Self {
+                determinant: umls_constitutive::determinant(d),
+                trace: d.trace(),
+            },
+        )
     }
 }
 

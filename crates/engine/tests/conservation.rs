@@ -89,15 +89,18 @@ fn mass_and_momentum_are_conserved_for_every_kernel_and_transfer() {
     every_transfer!(LinearFeKernel::new(mesh()));
     every_transfer!(grid(BSplineOrder::Quadratic));
     every_transfer!(grid(BSplineOrder::Cubic));
-    // MLS-MPM: B-splines and USL only (the combinations it refuses are tested below);
-    // its folded force Σ_i N_i (m C − Δt V τ D⁻¹)(x_i − x_p) vanishes with Σ_i N_i r_i.
+    // MLS-MPM: B-splines and UMLS (each particle's own D_p), USL only (the combinations
+    // it refuses are tested below); its folded force Σ_i N_i (m C − Δt V τ D⁻¹)(x_i − x_p)
+    // vanishes with Σ_i N_i r_i.
     check(grid(BSplineOrder::Quadratic), MlsMpm, StressUpdate::Usl);
     check(grid(BSplineOrder::Cubic), MlsMpm, StressUpdate::Usl);
+    check(Umls2::new(mesh()), MlsMpm, StressUpdate::Usl);
+    check(corrected, MlsMpm, StressUpdate::Usl);
 }
 
-/// MLS-MPM's force needs one constant D_p and a nodal force it does not have: a mesh
-/// kernel, damping and MUSL are refused by name, at construction and at a step after
-/// the public settings changed.
+/// MLS-MPM's force needs D_p⁻¹ and a nodal force it does not have: linear elements
+/// (whose D_p vanishes at the vertices), damping and MUSL are refused by name, at
+/// construction and at a step after the public settings changed; UMLS is accepted.
 #[test]
 fn mls_mpm_refuses_what_it_cannot_do() {
     let material = NeoHookean {
@@ -113,8 +116,15 @@ fn mls_mpm_refuses_what_it_cannot_do() {
         other => panic!("expected Unsupported, got {other}"),
     };
     let settings = StepSettings::new(1e-4);
-    let mesh_kernel = Simulation::new(Umls2::new(mesh()), material, MlsMpm, disk(), settings);
-    unsupported(mesh_kernel.err().unwrap(), "kernel");
+    let linear = Simulation::new(
+        LinearFeKernel::new(mesh()),
+        material,
+        MlsMpm,
+        disk(),
+        settings,
+    );
+    unsupported(linear.err().unwrap(), "linear elements");
+    assert!(Simulation::new(Umls2::new(mesh()), material, MlsMpm, disk(), settings).is_ok());
     let mut musl = settings;
     musl.stress_update = StressUpdate::Musl;
     let refused = Simulation::new(
@@ -136,6 +146,78 @@ fn mls_mpm_refuses_what_it_cannot_do() {
     sim.step().unwrap();
     sim.settings.damping = umls_engine::Damping::MassProportional { beta: 1.0 };
     unsupported(sim.step().err().unwrap(), "damping");
+}
+
+/// Nearest-node values on the integers of [0, 8] (N = 1 at the nearest node, ∇N = 0),
+/// claiming a regular second moment: D_p = 0 everywhere, which MLS-MPM must report.
+struct NearestNode;
+
+impl Kernel<1> for NearestNode {
+    type Cache = ();
+    fn node_count(&self) -> usize {
+        9
+    }
+    fn node_position(&self, node: usize) -> SVector<f64, 1> {
+        SVector::from([node as f64])
+    }
+    fn spacing(&self) -> f64 {
+        1.0
+    }
+    fn stencil(
+        &self,
+        x: &SVector<f64, 1>,
+        _: &mut (),
+        out: &mut umls_transfer::Stencil<1>,
+    ) -> Result<(), umls_transfer::KernelError> {
+        let node = x[0].round().clamp(0.0, 8.0);
+        out.clear();
+        out.push(
+            node as u32,
+            1.0,
+            SVector::zeros(),
+            SVector::from([node - x[0]]),
+        );
+        Ok(())
+    }
+    fn regular_second_moment(&self) -> bool {
+        true
+    }
+}
+
+/// A particle whose D_p has no inverse stops an MLS-MPM run with a step error naming
+/// it and the cause, whichever way the stencils are kept.
+#[test]
+fn a_singular_second_moment_stops_mls_mpm_naming_the_particle() {
+    for storage in [
+        umls_engine::StencilStorage::Store,
+        umls_engine::StencilStorage::Recompute,
+    ] {
+        let particles = Particles::at_rest(
+            vec![SVector::from([2.0]), SVector::from([4.25])],
+            vec![1.0; 2],
+            1.0,
+            (),
+        );
+        let mut settings = StepSettings::new(1e-3);
+        settings.stencil_storage = storage;
+        let material = umls_constitutive::WeaklyCompressibleFluid::new(400.0, 1.0).unwrap();
+        let mut sim = Simulation::new(NearestNode, material, MlsMpm, particles, settings)
+            .expect("the kernel claims a regular D_p");
+        match sim.step().unwrap_err() {
+            umls_engine::EngineError::Kernel {
+                step: 0,
+                particle: 0,
+                source: umls_transfer::KernelError::Evaluation { source, .. },
+            } => {
+                let cause = source
+                    .downcast_ref::<umls_engine::SingularSecondMoment>()
+                    .expect("the cause is the singular moment");
+                assert_eq!(cause.trace, 0.0, "{storage:?}");
+                assert!(source.to_string().contains("MLS-MPM"), "{source}");
+            }
+            other => panic!("{storage:?}: expected the singular moment, got {other}"),
+        }
+    }
 }
 
 #[test]

@@ -257,6 +257,46 @@ fn stored_factored_and_recomputed_stencils_give_the_same_bits() {
     );
 }
 
+/// MLS-MPM with UMLS, whose D_p is each particle's own (summed with the stored entries,
+/// or from the stencil where factored or recomputed): the same bits on 1, 2 and 4
+/// threads and with every storage, in 2D with more particles than one P2G block holds
+/// (the blocks are scattered in parallel) and in 3D.
+#[test]
+fn mls_mpm_with_umls_is_independent_of_threads_and_storage() {
+    fn same<const D: usize, K: Kernel<D> + Clone + Send + Sync>(name: &str, kernel: K, h: f64) {
+        let stored = state_with(&kernel, MlsMpm, h, 12, 1, StencilStorage::Store);
+        assert!(stored.1.iter().any(|v| v.norm() > 0.1), "{name}");
+        for threads in [1, 2, 4] {
+            for storage in [
+                StencilStorage::Store,
+                StencilStorage::Factored,
+                StencilStorage::Recompute,
+            ] {
+                assert!(
+                    state_with(&kernel, MlsMpm, h, 12, threads, storage) == stored,
+                    "{name}: {storage:?} on {threads} threads differs from stored on 1"
+                );
+            }
+        }
+        // Not APIC's bits: the force's gradient is another.
+        assert!(state_with(&kernel, Apic, h, 12, 1, StencilStorage::Store) != stored);
+    }
+    let mesh = Lattice::new([0.0, 0.0], [1.0, 1.0], [40, 40]).jitter(0.2, 5);
+    let triangles = Arc::new(mesh.triangles(Diagonal::Alternating).unwrap());
+    let kernel = Umls2::new(triangles).with_integration_correction().unwrap();
+    let count = spinning_block::particles::<2, ()>(0.005, 1.0)
+        .position
+        .len();
+    assert!(count > PARALLEL_SCATTER, "{count} particles");
+    same("umls 2D", kernel, 0.005);
+    let tets = Lattice::new([0.0; 3], [1.0; 3], [6; 3]).jitter(0.2, 3);
+    same(
+        "umls 3D",
+        Umls3::new(Arc::new(tets.tetrahedra().unwrap())),
+        0.05,
+    );
+}
+
 /// B-spline stencils that are not stored are summed row by row along axis 0
 /// (`Kernel::tensor_stencil`): under every transfer scheme, in 2D and 3D, quadratic and
 /// cubic, the particles come out as with the stored entries summed one by one, to

@@ -433,6 +433,14 @@ where
         self.correction.as_deref()
     }
 
+    /// The fit's stencil is the host's whole 1-ring, whose vertices surround the point
+    /// at every place in the host, so D_p keeps the order of h² (linear elements' D_p
+    /// vanishes at the vertices); where a particle's D_p is not positive definite the
+    /// engine reports it.
+    fn regular_second_moment(&self) -> bool {
+        true
+    }
+
     /// With the reconstructed gradient: the fit's M⁻¹ and 1/s per particle and its
     /// weight per ring vertex ([`UmlsFit`]). The full and frozen-η gradients also need
     /// the weights' gradients and are not factored.

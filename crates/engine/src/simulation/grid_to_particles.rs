@@ -14,7 +14,7 @@ use crate::error::EngineError;
 use crate::parallel::lowest_failure;
 use crate::quadratic_modes::{ModeSums, QuadraticModes};
 use crate::stencils::{EntrySink, Stencils};
-use crate::transfer::{StressUpdate, TransferScheme};
+use crate::transfer::{SingularSecondMoment, StressUpdate, TransferScheme, regular_inverse};
 
 /// What G2P computes for one particle.
 #[derive(Debug, Clone, Copy)]
@@ -169,6 +169,11 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
     }
     let affine = match moment_scale {
         Some(s) => transfer.affine_with_constant_moment(&b, s, &grad_v),
+        // MLS-MPM's C_p is also its velocity gradient, so it has no fallback where D_p
+        // is singular (APIC's is ∇v): the particle is reported, as P2G reports it.
+        None if T::FUSED_FORCE => {
+            b * regular_inverse(&d).ok_or_else(|| (p, SingularSecondMoment::of::<D, K>(&d)))?
+        }
         None => transfer.affine(&b, &d, &grad_v),
     };
     Ok(ParticleUpdate {

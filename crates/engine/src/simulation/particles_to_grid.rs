@@ -4,7 +4,7 @@
 
 use nalgebra::{SMatrix, SVector};
 use umls_constitutive::Constitutive;
-use umls_transfer::{Kernel, Stencil};
+use umls_transfer::{Kernel, KernelError, Stencil};
 
 use super::Simulation;
 use super::tensor_rows::{ParticleLoad, row_width, scatter_rows};
@@ -12,7 +12,7 @@ use crate::error::EngineError;
 use crate::quadratic_modes::{ModeFrame, QuadraticModes};
 use crate::scatter::Window;
 use crate::stencils::{EntrySink, correction_mean, second_moment};
-use crate::transfer::TransferScheme;
+use crate::transfer::{SingularSecondMoment, TransferScheme, regular_inverse};
 
 /// The affine matrix P2G spreads: C_p, scaled down if its kinetic energy at the
 /// particle's new position, tr(C D C^T) with D = Σ N r rᵀ there, exceeds what it had
@@ -31,6 +31,23 @@ fn limited_affine<const D: usize>(
     }
     let d = d();
     c * field_limit((c * d * c.transpose()).trace(), moment)
+}
+
+/// MLS-MPM's affine load with a particle's own second moment `d`: m C − Δt V τ D_p⁻¹,
+/// C limited as APIC's is where D varies ([`limited_affine`]); `impulse` is Δt V τ.
+///
+/// # Errors
+/// [`SingularSecondMoment`] where D_p has no usable inverse.
+#[inline]
+fn fused_affine<const D: usize, K>(
+    c: &SMatrix<f64, D, D>,
+    moment: f64,
+    d: &SMatrix<f64, D, D>,
+    mass: f64,
+    impulse: &SMatrix<f64, D, D>,
+) -> Result<SMatrix<f64, D, D>, KernelError> {
+    let inverse = regular_inverse(d).ok_or_else(|| SingularSecondMoment::of::<D, K>(d))?;
+    Ok(limited_affine(c, moment, || *d) * mass - impulse * inverse)
 }
 
 /// The factor that brings the energy `now` of a particle's affine and quadratic fields
@@ -119,7 +136,13 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let nonnegative = self.kernel.nonnegative_values();
         self.grid.abs_mass_is_mass = nonnegative;
         self.grid.momentum_only = T::FUSED_FORCE;
-        match (self.kernel.force_gradient_correction(), nonnegative) {
+        // MLS-MPM's gradient is D_p⁻¹ N_i r_i, not the kernel's, so the kernel's
+        // correction of its gradient does not apply.
+        let corrected = self
+            .kernel
+            .force_gradient_correction()
+            .filter(|_| !T::FUSED_FORCE);
+        match (corrected, nonnegative) {
             (Some(_), false) => self.scatter_particles::<true, 1>(),
             (Some(_), true) => self.scatter_particles::<true, 0>(),
             (None, false) => self.scatter_particles::<false, 1>(),
@@ -152,7 +175,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // With a constant second moment (B-splines) the affine energy cannot grow as a
         // particle moves, and the limiter has nothing to do.
         let varying_moment = kernel.constant_second_moment().is_none();
-        // MLS-MPM's D (checked constant when the simulation starts and every step).
+        // MLS-MPM's D where it is one constant (B-splines); otherwise each particle's.
         let constant_moment = kernel.constant_second_moment().unwrap_or(f64::NAN);
         let dt = self.dt;
         let ranges = stencils.ranges();
@@ -207,9 +230,22 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     if T::FUSED_FORCE {
                         // MLS-MPM: ∇N_i ≈ D⁻¹ N_i r_i folds the stress impulse into the
                         // affine term, and gravity into the momentum.
-                        let inverse_moment = 1.0 / constant_moment;
-                        sink.load.affine = p.affine[i] * m - stress_volume * (dt * inverse_moment);
                         sink.load.velocity = (v + acceleration * dt) * m;
+                        if !varying_moment {
+                            let inverse_moment = 1.0 / constant_moment;
+                            sink.load.affine =
+                                p.affine[i] * m - stress_volume * (dt * inverse_moment);
+                        } else if let Some(d) = stored_moment {
+                            sink.load.affine = fused_affine::<D, K>(
+                                &p.affine[i],
+                                p.affine_moment[i],
+                                d,
+                                m,
+                                &(stress_volume * dt),
+                            )
+                            .map_err(|e| (i, e))?;
+                        }
+                        // Otherwise D_p is summed from the stencil below (`limiter_reads`).
                     } else if let Some(d) = stored_moment.filter(|_| T::AFFINE) {
                         // D_p summed with the stencil ([`Stencils::compute`]): the entries
                         // are visited once.
@@ -231,41 +267,55 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         }
                     } else if limiter_reads || mean_reads || T::QUADRATIC {
                         // One evaluation serves the whole-stencil sums and the entries.
-                        stencils.with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
-                            if let Some(xi) = correction.filter(|_| mean_reads) {
-                                sink.correction_mean = correction_mean(&st, xi);
-                            }
-                            if limiter_reads {
-                                sink.load.affine =
-                                    limited_affine(&p.affine[i], p.affine_moment[i], || {
-                                        second_moment(&st, kernel, &x)
-                                    });
-                            }
-                            if T::QUADRATIC {
-                                // The modes' frame at the particle's new position, and one
-                                // limit for C_p and the modes together.
-                                let entries = || {
-                                    (0..st.len()).map(|e| (st.values[e], st.offset(e, kernel, &x)))
-                                };
-                                if let Some((frame, summed)) = ModeFrame::of_stencil(entries()) {
-                                    let (c, modes) = (p.affine[i], p.quadratic[i]);
-                                    let d = if varying_moment {
-                                        summed
-                                    } else {
-                                        SMatrix::identity() * constant_moment
-                                    };
-                                    let now = (c * d * c.transpose()).trace()
-                                        + frame.energy(&modes, entries());
-                                    let limit = field_limit(now, p.affine_moment[i]);
-                                    sink.load.affine = c * limit;
-                                    sink.modes = Some((frame, modes.map(|m| m * limit)));
+                        stencils
+                            .with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
+                                if let Some(xi) = correction.filter(|_| mean_reads) {
+                                    sink.correction_mean = correction_mean(&st, xi);
                                 }
-                            }
-                            for e in 0..st.len() {
-                                let r = st.offset(e, kernel, &x);
-                                sink.entry(st.nodes[e], st.values[e], &st.gradients[e], &r);
-                            }
-                        })?;
+                                if T::FUSED_FORCE && limiter_reads {
+                                    let d = second_moment(&st, kernel, &x);
+                                    sink.load.affine = fused_affine::<D, K>(
+                                        &p.affine[i],
+                                        p.affine_moment[i],
+                                        &d,
+                                        m,
+                                        &(stress_volume * dt),
+                                    )?;
+                                } else if limiter_reads {
+                                    sink.load.affine =
+                                        limited_affine(&p.affine[i], p.affine_moment[i], || {
+                                            second_moment(&st, kernel, &x)
+                                        });
+                                }
+                                if T::QUADRATIC {
+                                    // The modes' frame at the particle's new position, and one
+                                    // limit for C_p and the modes together.
+                                    let entries = || {
+                                        (0..st.len())
+                                            .map(|e| (st.values[e], st.offset(e, kernel, &x)))
+                                    };
+                                    if let Some((frame, summed)) = ModeFrame::of_stencil(entries())
+                                    {
+                                        let (c, modes) = (p.affine[i], p.quadratic[i]);
+                                        let d = if varying_moment {
+                                            summed
+                                        } else {
+                                            SMatrix::identity() * constant_moment
+                                        };
+                                        let now = (c * d * c.transpose()).trace()
+                                            + frame.energy(&modes, entries());
+                                        let limit = field_limit(now, p.affine_moment[i]);
+                                        sink.load.affine = c * limit;
+                                        sink.modes = Some((frame, modes.map(|m| m * limit)));
+                                    }
+                                }
+                                for e in 0..st.len() {
+                                    let r = st.offset(e, kernel, &x);
+                                    sink.entry(st.nodes[e], st.values[e], &st.gradients[e], &r);
+                                }
+                                Ok(())
+                            })?
+                            .map_err(|e| (i, e))?;
                     } else {
                         stencils.visit(
                             i,
