@@ -434,9 +434,10 @@ where
     }
 
     /// The fit's stencil is the host's whole 1-ring, whose vertices surround the point
-    /// at every place in the host, so D_p keeps the order of h² (linear elements' D_p
-    /// vanishes at the vertices); where a particle's D_p is not positive definite the
-    /// engine reports it.
+    /// wherever the host is not on the mesh's boundary, so D_p keeps the order of h²
+    /// there (linear elements' D_p vanishes at the vertices). At a corner of the mesh
+    /// the fit is one-sided and D_p can be indefinite; the engine reports a particle
+    /// whose D_p it cannot invert.
     fn regular_second_moment(&self) -> bool {
         true
     }

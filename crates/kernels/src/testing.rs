@@ -4,7 +4,12 @@
 //!
 //! - partition of unity Σ N_i = 1 and Σ ∇N_i = 0;
 //! - linear reproduction of positions Σ N_i x_i = x and gradients Σ x_i ∇N_iᵀ = I;
-//! - the second moment the kernel declares (`Kernel::constant_second_moment`), if any;
+//! - the second moment the kernel declares (`Kernel::constant_second_moment`), if any,
+//!   and where it declares D_p regular (`Kernel::regular_second_moment`), a D_p that is
+//!   positive definite, not near singular (det D_p > 10⁻⁶ (tr D_p / D)^D, the engine's
+//!   test before it inverts it) and not vanishing (tr D_p > 10⁻³ h²) wherever the
+//!   stencil's nodes surround the point (some node at least h/2 ahead along every
+//!   direction: a fit at the domain's boundary is one-sided);
 //! - no negative value where the kernel declares its values never negative
 //!   (`Kernel::nonnegative_values`), with no -0.0 either (|N| m must be N m bit for bit);
 //! - node indices below `node_count`;
@@ -57,6 +62,36 @@ impl std::fmt::Display for Violation {
 }
 
 impl std::error::Error for Violation {}
+
+/// Whether the stencil's nodes surround the point, as away from the domain's boundary:
+/// along every direction of a fine set (the integer vectors of [−4, 4]^D, normalised)
+/// some node lies at least h/2 ahead.
+fn surrounded<const D: usize>(offsets: &[SVector<f64, D>], h: f64) -> bool {
+    let k = 4i32;
+    let count = (2 * k + 1).pow(D as u32);
+    (0..count).all(|code| {
+        let mut u = SVector::<f64, D>::zeros();
+        let mut rest = code;
+        for c in u.iter_mut() {
+            *c = f64::from(rest % (2 * k + 1) - k);
+            rest /= 2 * k + 1;
+        }
+        let norm = u.norm();
+        norm == 0.0 || offsets.iter().any(|r| r.dot(&u) >= 0.5 * h * norm)
+    })
+}
+
+/// Whether a second moment is what `Kernel::regular_second_moment` promises: positive
+/// definite (Cholesky succeeds), det D > 10⁻⁶ (tr D / D)^D as the engine requires before
+/// inverting it, and tr D > 10⁻³ h².
+fn regular<const D: usize>(moment: &SMatrix<f64, D, D>, h: f64) -> bool {
+    let Some(cholesky) = moment.cholesky() else {
+        return false;
+    };
+    let trace = moment.trace();
+    let det = cholesky.l_dirty().diagonal().product().powi(2);
+    det > 1e-6 * (trace / D as f64).powi(D as i32) && trace > 1e-3 * h * h
+}
 
 /// Checks `kernel` at each of `points` (which must lie in its domain) and that
 /// `outside` is reported as outside the domain.
@@ -130,6 +165,12 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
             if (moment - SMatrix::<f64, D, D>::identity() * s).norm() >= REPRODUCTION * s {
                 return Err(fail(format!("Σ N r rᵀ = {moment}, not the declared {s} I")));
             }
+        }
+        if kernel.regular_second_moment() && surrounded(st.offsets(), h) && !regular(&moment, h) {
+            return Err(fail(format!(
+                "Σ N r rᵀ = {moment} is declared regular but is not positive definite, \
+                 is near singular or vanishes"
+            )));
         }
         let range = kernel
             .node_range(x, &mut K::Cache::default(), &mut fresh)

@@ -350,11 +350,12 @@ pub trait Kernel<const D: usize>: Send + Sync {
     }
 
     /// Whether the second moment D_p = Σ_i N_i(x) (x_i − x)(x_i − x)ᵀ stays positive
-    /// definite and of the order of h² wherever the kernel is evaluated, so that
-    /// D_p⁻¹ N_i (x_i − x_p) is a usable gradient (MLS-MPM's). True where D_p is
+    /// definite and of the order of h² wherever the stencil's nodes surround the point,
+    /// so that D_p⁻¹ N_i (x_i − x_p) is a usable gradient (MLS-MPM's). True where D_p is
     /// constant (B-splines, the default) and for MLS fits, whose stencils reach past
-    /// the host cell; false for linear elements, whose D_p vanishes at every vertex.
-    /// The engine still checks each particle's D_p where it inverts it.
+    /// the host cell; false for linear elements, whose D_p vanishes at every vertex. At
+    /// the domain's boundary an MLS fit is one-sided and its D_p can be indefinite (at a
+    /// corner of the mesh), so the engine checks each particle's D_p where it inverts it.
     fn regular_second_moment(&self) -> bool {
         self.constant_second_moment().is_some()
     }
