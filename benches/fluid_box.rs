@@ -3,10 +3,10 @@
 //! box of slip walls three cells in from its faces, APIC, Δt = 2·10⁻⁴. One step per
 //! iteration, in particle-steps per second, with 1 and 2 threads, for quadratic B-splines
 //! on the 64³ grid and UMLS on the 64³-cell Kuhn lattice of tetrahedra (1.57 M tets, the
-//! same node spacing), and quadratic B-splines with MLS-MPM (Taichi's own transfer: the
-//! force folded into the affine momentum); UMLS once more with its stencils kept as the
-//! fits' factors (`StencilStorage::Factored`: half the memory, rebuilt in P2G and G2P).
-//! The comparison with Taichi runs the same scene through
+//! same node spacing), both also with MLS-MPM (Taichi's own transfer: the force folded
+//! into the affine momentum; UMLS with each particle's own D_p); UMLS once more with its
+//! stencils kept as the fits' factors (`StencilStorage::Factored`: half the memory, rebuilt in P2G and G2P).
+//! The comparison with Taichi runs the same scene through
 //! `umls run fluid-box-3d`; this bench isolates the step from scene set-up and output.
 
 use std::sync::Arc;
@@ -101,6 +101,8 @@ fn fluid_box(c: &mut Criterion) {
         .expect("mesh");
     let umls = Umls3::new(Arc::new(mesh));
     bench(c, "umls_tet", umls.clone(), Apic, auto);
+    // MLS-MPM with each particle's own D_p.
+    bench(c, "umls_tet_mls_mpm", umls.clone(), MlsMpm, auto);
     bench(c, "umls_tet_factored", umls, Apic, StencilStorage::Factored);
 }
 
