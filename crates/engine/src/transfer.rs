@@ -2,6 +2,7 @@
 //! code) and the stress-update variants.
 
 use nalgebra::{SMatrix, SVector};
+use umls_transfer::regular_inverse;
 
 /// A velocity transfer scheme: how particle momentum reaches the grid and how grid
 /// velocities come back to the particle.
@@ -200,24 +201,7 @@ impl TransferScheme for Apic {
     }
 }
 
-/// D⁻¹ of a second moment that is positive definite (Cholesky succeeds) and not near
-/// singular (det D > 10⁻⁶ (tr D / D)^D); `None` otherwise. APIC falls back to the
-/// velocity gradient there, and MLS-MPM, whose gradient is D⁻¹ N_i (x_i − x_p), reports
-/// the particle ([`SingularSecondMoment`]).
-#[inline]
-pub(crate) fn regular_inverse<const D: usize>(
-    d: &SMatrix<f64, D, D>,
-) -> Option<SMatrix<f64, D, D>> {
-    let cholesky = d.cholesky()?;
-    let scale = (d.trace() / D as f64).powi(D as i32);
-    let det = cholesky.l_dirty().diagonal().product().powi(2);
-    if det.is_nan() || det <= 1e-6 * scale {
-        return None;
-    }
-    Some(cholesky.inverse())
-}
-
-/// A particle's second moment D_p that MLS-MPM cannot invert (see [`regular_inverse`]),
+/// A particle's second moment D_p that MLS-MPM cannot invert ([`regular_inverse`]),
 /// reported as the cause of a [`umls_transfer::KernelError::Evaluation`] with the
 /// particle and step ([`crate::EngineError::Kernel`]).
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]

@@ -81,16 +81,10 @@ fn surrounded<const D: usize>(offsets: &[SVector<f64, D>], h: f64) -> bool {
     })
 }
 
-/// Whether a second moment is what `Kernel::regular_second_moment` promises: positive
-/// definite (Cholesky succeeds), det D > 10⁻⁶ (tr D / D)^D as the engine requires before
-/// inverting it, and tr D > 10⁻³ h².
+/// Whether a second moment is what `Kernel::regular_second_moment` promises: one the
+/// engine inverts ([`umls_transfer::regular_inverse`]) and tr D > 10⁻³ h².
 fn regular<const D: usize>(moment: &SMatrix<f64, D, D>, h: f64) -> bool {
-    let Some(cholesky) = moment.cholesky() else {
-        return false;
-    };
-    let trace = moment.trace();
-    let det = cholesky.l_dirty().diagonal().product().powi(2);
-    det > 1e-6 * (trace / D as f64).powi(D as i32) && trace > 1e-3 * h * h
+    umls_transfer::regular_inverse(moment).is_some() && moment.trace() > 1e-3 * h * h
 }
 
 /// Checks `kernel` at each of `points` (which must lie in its domain) and that

@@ -34,6 +34,7 @@
 //! # Ok::<(), KernelError>(())
 //! ```
 
+mod second_moment;
 mod stencil;
 mod tensor;
 
@@ -42,6 +43,7 @@ use std::sync::Arc;
 use nalgebra::SVector;
 use thiserror::Error;
 
+pub use second_moment::regular_inverse;
 pub use stencil::{EntriesMut, Stencil, node_range};
 pub use tensor::TensorStencil;
 

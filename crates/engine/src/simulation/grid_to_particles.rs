@@ -4,7 +4,7 @@
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 use umls_constitutive::Constitutive;
-use umls_transfer::{Kernel, KernelError, Stencil};
+use umls_transfer::{Kernel, KernelError, Stencil, regular_inverse};
 
 use super::Simulation;
 use super::constitutive::update_one;
@@ -14,7 +14,7 @@ use crate::error::EngineError;
 use crate::parallel::lowest_failure;
 use crate::quadratic_modes::{ModeSums, QuadraticModes};
 use crate::stencils::{EntrySink, Stencils};
-use crate::transfer::{SingularSecondMoment, StressUpdate, TransferScheme, regular_inverse};
+use crate::transfer::{SingularSecondMoment, StressUpdate, TransferScheme};
 
 /// What G2P computes for one particle.
 #[derive(Debug, Clone, Copy)]

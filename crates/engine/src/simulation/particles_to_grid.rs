@@ -4,7 +4,7 @@
 
 use nalgebra::{SMatrix, SVector};
 use umls_constitutive::Constitutive;
-use umls_transfer::{Kernel, KernelError, Stencil};
+use umls_transfer::{Kernel, KernelError, Stencil, regular_inverse};
 
 use super::Simulation;
 use super::tensor_rows::{ParticleLoad, row_width, scatter_rows};
@@ -12,7 +12,7 @@ use crate::error::EngineError;
 use crate::quadratic_modes::{ModeFrame, QuadraticModes};
 use crate::scatter::Window;
 use crate::stencils::{EntrySink, correction_mean, second_moment};
-use crate::transfer::{SingularSecondMoment, TransferScheme, regular_inverse};
+use crate::transfer::{SingularSecondMoment, TransferScheme};
 
 /// The affine matrix P2G spreads: C_p, scaled down if its kinetic energy at the
 /// particle's new position, tr(C D C^T) with D = Σ N r rᵀ there, exceeds what it had
