@@ -18,7 +18,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::{cargo, cargo_in, option_value, positive_integer, target_dir, workspace_root};
+use crate::{cargo, cargo_in, machine, option_value, positive_integer, target_dir, workspace_root};
 
 /// The stages of `summary.json`'s `stage_seconds`, in the step's order.
 const STAGES: [&str; 6] = [
@@ -310,7 +310,10 @@ pub fn compare(args: &[String]) -> Result<(), String> {
             result.same_history &= histories[0] == histories[1];
         }
     }
-    let report = render(&args.base, args.threads, &results);
+    let report = machine::after_title(
+        &render(&args.base, args.threads, &results),
+        &machine::machine_line(&root),
+    );
     let path = dir.join("compare.md");
     std::fs::write(&path, &report).map_err(|e| fail(&path, e))?;
     println!("{report}");

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::compare::{median, parse_summary, run_summary};
-use crate::{cargo, option_value, positive_integer, target_dir};
+use crate::{cargo, machine, option_value, positive_integer, target_dir, workspace_root};
 
 /// The Taichi release the measurements use (the one the engine's issue measured).
 const TAICHI: &str = "taichi==1.7.4";
@@ -315,7 +315,10 @@ pub fn peers(args: &[String]) -> Result<(), String> {
             umls[c].push(r);
         }
     }
-    let report = render(&args, &taichi, &umls);
+    let report = machine::after_title(
+        &render(&args, &taichi, &umls),
+        &machine::machine_line(&workspace_root()),
+    );
     let path = dir.join("peers.md");
     std::fs::write(&path, &report).map_err(|e| fail(&path, e))?;
     println!("{report}");
