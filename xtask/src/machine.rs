@@ -2,8 +2,8 @@
 //! extensions, hardware threads, revision and date.
 //!
 //! Timings of `peers` and `compare` mean little without the machine: the engine's lead
-//! over Taichi has been measured at 1.8× on one CPU and 3.4× on another with the same
-//! code (docs/scenes.md, *fluid-box-3d*). Virtual machines often name the processor
+//! over Taichi has been measured at 1.8× on one CPU and 3.0–3.4× on another
+//! (docs/scenes.md, *fluid-box-3d*). Virtual machines often name the processor
 //! only by its brand ("AMD EPYC"), so the family and model numbers, which tell its
 //! generation, and the vector extensions, which `-C target-cpu=native` builds for, are
 //! given with it.
@@ -11,37 +11,18 @@
 use std::path::Path;
 use std::process::Command;
 
-/// "NAME (vendor family F, model M; AVX-512, FMA; N hardware threads)" from the text
-/// of `/proc/cpuinfo` (its first processor), or "unknown processor" where it names none.
+use crate::cpu;
+
+/// "NAME (family F, model M; AVX-512, FMA; N hardware threads)" from the text of
+/// `/proc/cpuinfo` (its first processor; `crate::cpu`, the comparison report's own
+/// reading), or "unknown processor (…)" where it names none.
 pub fn describe_cpu(cpuinfo: &str, threads: usize) -> String {
-    let field = |name: &str| {
-        cpuinfo
-            .lines()
-            .filter_map(|l| l.split_once(':'))
-            .find(|(key, _)| key.trim() == name)
-            .map(|(_, value)| value.trim().to_string())
-    };
-    let mut parts = Vec::new();
-    if let (Some(family), Some(model)) = (field("cpu family"), field("model")) {
-        parts.push(format!("family {family}, model {model}"));
-    }
-    let flags = field("flags").unwrap_or_default();
-    let has = |flag: &str| flags.split_whitespace().any(|f| f == flag);
-    let vectors: Vec<&str> = [("avx512f", "AVX-512"), ("avx2", "AVX2"), ("fma", "FMA")]
-        .into_iter()
-        .filter(|(flag, _)| has(flag))
-        // AVX-512 implies AVX2: name the widest only.
-        .filter(|(flag, _)| *flag != "avx2" || !has("avx512f"))
-        .map(|(_, name)| name)
-        .collect();
-    if !vectors.is_empty() {
-        parts.push(vectors.join(", "));
-    }
+    let mut parts = cpu::cpu_details(cpuinfo);
     parts.push(format!(
         "{threads} hardware thread{}",
         if threads == 1 { "" } else { "s" }
     ));
-    let name = field("model name").unwrap_or_else(|| "unknown processor".into());
+    let name = cpu::cpu_name(cpuinfo).unwrap_or_else(|| "unknown processor".into());
     format!("{name} ({})", parts.join("; "))
 }
 
@@ -81,17 +62,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn family_model_and_the_widest_vectors_are_named() {
-        // `model name` before `model`, which it must not be taken for; the second
-        // processor's fields are not read.
-        let amd = "processor\t: 0\nvendor_id\t: AuthenticAMD\nmodel name\t: AMD EPYC\n\
-                   cpu family\t: 26\nmodel\t\t: 2\n\
-                   flags\t\t: fpu sse2 avx2 fma avx512f avx512vl\n\n\
-                   processor\t: 1\ncpu family\t: 99\n";
-        assert_eq!(
-            describe_cpu(amd, 2),
-            "AMD EPYC (family 26, model 2; AVX-512, FMA; 2 hardware threads)"
-        );
+    fn the_processor_is_described_with_its_threads() {
         let zen3 = "cpu family\t: 25\nmodel\t\t: 1\nmodel name\t: AMD EPYC 7B13\n\
                     flags\t\t: fpu avx2 fma\n";
         assert_eq!(

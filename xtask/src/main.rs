@@ -25,6 +25,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
 mod compare;
+// The comparison report's reading of /proc/cpuinfo, shared as source so that xtask
+// stays free of the workspace's crates.
+#[path = "../../crates/report/src/cpu.rs"]
+mod cpu;
 mod machine;
 mod peers;
 

@@ -9,6 +9,9 @@ use std::process::Command;
 pub struct Host {
     /// Processor model (from `/proc/cpuinfo` where available).
     pub cpu: String,
+    /// Family and model numbers and the widest vector extensions, "; "-separated
+    /// ([`crate::cpu::cpu_details`]; empty where `/proc/cpuinfo` gives none).
+    pub cpu_details: String,
     /// Hardware threads the system offers.
     pub cores: usize,
     /// Operating system and architecture.
@@ -22,15 +25,9 @@ pub struct Host {
 impl Host {
     /// Reads the host; `workspace` is where git is asked for the revision.
     pub fn detect(workspace: &Path) -> Self {
-        let cpu = std::fs::read_to_string("/proc/cpuinfo")
-            .ok()
-            .and_then(|t| {
-                t.lines()
-                    .find(|l| l.starts_with("model name"))
-                    .and_then(|l| l.split_once(':'))
-                    .map(|(_, v)| v.trim().to_string())
-            })
-            .unwrap_or_else(|| "unknown".into());
+        let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+        let cpu = crate::cpu::cpu_name(&cpuinfo).unwrap_or_else(|| "unknown".into());
+        let cpu_details = crate::cpu::cpu_details(&cpuinfo).join("; ");
         let revision = Command::new("git")
             .args(["describe", "--always", "--dirty"])
             .current_dir(workspace)
@@ -45,11 +42,26 @@ impl Host {
             .unwrap_or(0);
         Self {
             cpu,
+            cpu_details,
             cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
             os: format!("{} {}", std::env::consts::OS, std::env::consts::ARCH),
             revision,
             date: civil_date(seconds / 86_400),
         }
+    }
+
+    /// "CPU (family F, model M; AVX-512, FMA; N hardware threads, OS)": the machine as
+    /// the report's first lines name it.
+    pub fn machine(&self) -> String {
+        let details = if self.cpu_details.is_empty() {
+            String::new()
+        } else {
+            format!("{}; ", self.cpu_details)
+        };
+        format!(
+            "{} ({details}{} hardware threads, {})",
+            self.cpu, self.cores, self.os
+        )
     }
 }
 
@@ -70,6 +82,27 @@ fn civil_date(days: u64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_machine_names_the_details_where_known() {
+        let mut host = Host {
+            cpu: "AMD EPYC".into(),
+            cpu_details: "family 26, model 2; AVX-512, FMA".into(),
+            cores: 2,
+            os: "linux x86_64".into(),
+            revision: "abc".into(),
+            date: "2026-12-02".into(),
+        };
+        assert_eq!(
+            host.machine(),
+            "AMD EPYC (family 26, model 2; AVX-512, FMA; 2 hardware threads, linux x86_64)"
+        );
+        host.cpu_details.clear();
+        assert_eq!(
+            host.machine(),
+            "AMD EPYC (2 hardware threads, linux x86_64)"
+        );
+    }
 
     #[test]
     fn civil_dates() {

@@ -12,7 +12,10 @@
 //! - [`charts`]: the charts of each study;
 //! - [`criterion`]: criterion's results, with throughput and the change against a
 //!   baseline;
-//! - [`report`]: the whole report.
+//! - [`report`]: the whole report;
+//! - [`host`] and [`cpu`]: the machine and revision it was made on (the processor's
+//!   family, model and vector extensions besides its name; `xtask` shares `cpu.rs` for
+//!   its speed reports).
 //!
 //! Dependencies beyond the workspace's: `toml` and `serde` (the matrix file), `serde_json`
 //! (runs' summaries, `results.json`) and `csv` (histories, `results.csv`).
@@ -45,6 +48,7 @@
 pub mod analysis;
 pub mod case;
 pub mod charts;
+pub mod cpu;
 pub mod criterion;
 mod error;
 pub mod host;

@@ -252,10 +252,15 @@ impl Document {
         let failed = records.iter().filter(|r| !r.completed()).count();
         self.line(format!("# {}\n", matrix.title));
         self.line(format!(
-            "Made by `umls report` (matrix `{}`) on {}: {} ({} hardware threads, {}), revision `{}`. \
+            "Made by `umls report` (matrix `{}`) on {}: {}, revision `{}`. \
              {} runs in {:.0} s, {} of them did not complete (each is listed with its cause).\n",
-            o.matrix_name, host.date, host.cpu, host.cores, host.os, host.revision,
-            records.len(), seconds, failed
+            o.matrix_name,
+            host.date,
+            host.machine(),
+            host.revision,
+            records.len(),
+            seconds,
+            failed
         ));
         self.line(format!(
             "Kernels: {}.\n",
