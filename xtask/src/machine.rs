@@ -1,5 +1,5 @@
 //! The line that says where a speed measurement was taken: processor, vector
-//! extensions, hardware threads, revision and date.
+//! extensions, hardware threads, operating system, revision and date.
 //!
 //! Timings of `peers` and `compare` mean little without the machine: the engine's lead
 //! over Taichi has been measured at 1.8× on one CPU and 3.0–3.4× on another
@@ -13,17 +13,12 @@ use std::process::Command;
 
 use crate::cpu;
 
-/// "NAME (family F, model M; AVX-512, FMA; N hardware threads)" from the text of
-/// `/proc/cpuinfo` (its first processor; `crate::cpu`, the comparison report's own
-/// reading), or "unknown processor (…)" where it names none.
-pub fn describe_cpu(cpuinfo: &str, threads: usize) -> String {
-    let mut parts = cpu::cpu_details(cpuinfo);
-    parts.push(format!(
-        "{threads} hardware thread{}",
-        if threads == 1 { "" } else { "s" }
-    ));
+/// "NAME (family F, model M; AVX-512, FMA; N hardware threads, OS)" from the text of
+/// `/proc/cpuinfo` (its first processor), in the comparison report's words
+/// ([`cpu::describe_machine`]); "unknown processor" where it names none.
+pub fn describe_cpu(cpuinfo: &str, threads: usize, os: &str) -> String {
     let name = cpu::cpu_name(cpuinfo).unwrap_or_else(|| "unknown processor".into());
-    format!("{name} ({})", parts.join("; "))
+    cpu::describe_machine(&name, &cpu::cpu_details(cpuinfo).join("; "), threads, os)
 }
 
 /// "Machine: … Revision `R`, DATE." for this machine and the checkout at `workspace`.
@@ -42,7 +37,11 @@ pub fn machine_line(workspace: &Path) -> String {
     };
     format!(
         "Machine: {}. Revision `{}`, {} (UTC).",
-        describe_cpu(&cpuinfo, threads),
+        describe_cpu(
+            &cpuinfo,
+            threads,
+            &format!("{} {}", std::env::consts::OS, std::env::consts::ARCH)
+        ),
         output("git", &["describe", "--always", "--dirty"]),
         output("date", &["-u", "+%Y-%m-%d %H:%M"]),
     )
@@ -66,12 +65,12 @@ mod tests {
         let zen3 = "cpu family\t: 25\nmodel\t\t: 1\nmodel name\t: AMD EPYC 7B13\n\
                     flags\t\t: fpu avx2 fma\n";
         assert_eq!(
-            describe_cpu(zen3, 1),
-            "AMD EPYC 7B13 (family 25, model 1; AVX2, FMA; 1 hardware thread)"
+            describe_cpu(zen3, 1, "linux x86_64"),
+            "AMD EPYC 7B13 (family 25, model 1; AVX2, FMA; 1 hardware thread, linux x86_64)"
         );
         assert_eq!(
-            describe_cpu("", 4),
-            "unknown processor (4 hardware threads)"
+            describe_cpu("", 4, "linux x86_64"),
+            "unknown processor (4 hardware threads, linux x86_64)"
         );
     }
 

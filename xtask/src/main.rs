@@ -15,11 +15,11 @@
 //!   by side with Taichi's own example of the scene, alternating runs, throughput and
 //!   peak memory with ratios to the same round's Taichi run (`peers.rs`; Taichi installed
 //!   from PyPI into `target/peers/venv` on first use; report in `target/peers/peers.md`).
+//! - `deny`: `cargo deny check` (needs `cargo install cargo-deny`).
 //!
 //! Both speed reports open with the machine they were measured on (`machine.rs`: the
 //! processor with its family, model and vector extensions, the hardware threads, the
 //! revision and the date), since their ratios depend on the CPU.
-//! - `deny`: `cargo deny check` (needs `cargo install cargo-deny`).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};

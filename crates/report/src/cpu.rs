@@ -38,6 +38,18 @@ pub fn cpu_details(cpuinfo: &str) -> Vec<String> {
     details
 }
 
+/// "NAME (DETAILS; N hardware threads, OS)", the machine as every speed report of the
+/// project names it (`details` as [`cpu_details`] joined by "; ", left out when empty).
+pub fn describe_machine(name: &str, details: &str, threads: usize, os: &str) -> String {
+    let details = if details.is_empty() {
+        String::new()
+    } else {
+        format!("{details}; ")
+    };
+    let plural = if threads == 1 { "" } else { "s" };
+    format!("{name} ({details}{threads} hardware thread{plural}, {os})")
+}
+
 /// The value of the first line whose key is `name` exactly (`model` is not
 /// `model name`); the first processor's, since it comes first.
 fn field(cpuinfo: &str, name: &str) -> Option<String> {
@@ -67,5 +79,22 @@ mod tests {
         assert_eq!(cpu_details(zen3), ["family 25, model 1", "AVX2, FMA"]);
         assert_eq!(cpu_name(""), None);
         assert!(cpu_details("").is_empty());
+    }
+
+    #[test]
+    fn the_description_leaves_out_empty_details_and_counts_threads() {
+        assert_eq!(
+            describe_machine(
+                "AMD EPYC",
+                "family 26, model 2; AVX-512, FMA",
+                2,
+                "linux x86_64"
+            ),
+            "AMD EPYC (family 26, model 2; AVX-512, FMA; 2 hardware threads, linux x86_64)"
+        );
+        assert_eq!(
+            describe_machine("AMD EPYC 7B13", "", 1, "linux x86_64"),
+            "AMD EPYC 7B13 (1 hardware thread, linux x86_64)"
+        );
     }
 }

@@ -51,17 +51,9 @@ impl Host {
     }
 
     /// "CPU (family F, model M; AVX-512, FMA; N hardware threads, OS)": the machine as
-    /// the report's first lines name it.
+    /// the report's first lines name it ([`crate::cpu::describe_machine`]).
     pub fn machine(&self) -> String {
-        let details = if self.cpu_details.is_empty() {
-            String::new()
-        } else {
-            format!("{}; ", self.cpu_details)
-        };
-        format!(
-            "{} ({details}{} hardware threads, {})",
-            self.cpu, self.cores, self.os
-        )
+        crate::cpu::describe_machine(&self.cpu, &self.cpu_details, self.cores, &self.os)
     }
 }
 
