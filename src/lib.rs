@@ -14,6 +14,8 @@
 //! - [`transfer`] (`umls-transfer`), [`kernels`] (`umls-kernels`), [`engine`]
 //!   (`umls-engine`): the kernel port, the UMLS / linear-FE / B-spline kernels, and the
 //!   explicit MPM engine;
+//! - [`runner`] (`umls-runner`): scenes as a library: the scene format, the built-in
+//!   scenes and the runner that steps any kernel through them ([`runner::run_with`]);
 //! - [`scenes`] (`umls-scenes`): the benchmark scenes with their references;
 //! - [`io`] (`umls-io`): Gmsh mesh reading, VTK (`.vtu`, `.pvd`) and CSV writing.
 //!
@@ -38,5 +40,6 @@ pub use umls_kernels as kernels;
 pub use umls_manifold as manifold;
 pub use umls_mesh as mesh;
 pub use umls_mls as mls;
+pub use umls_runner as runner;
 pub use umls_scenes as scenes;
 pub use umls_transfer as transfer;

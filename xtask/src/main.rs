@@ -1,6 +1,7 @@
 //! Project automation, run as `cargo xtask <command>`:
 //!
-//! - `ci`: format check, clippy with `-D warnings`, and the whole test suite in release mode.
+//! - `ci`: format check, clippy with `-D warnings`, the whole test suite in release mode,
+//!   and the custom-kernel example.
 //! - `bench [--quick] [--no-criterion] [--save-baseline NAME | --baseline NAME] [--docs]`:
 //!   the comparison report in `target/report/` (`umls report`: the study matrix of
 //!   scenes × kernels × resolutions, charts, raw results), after the criterion benches of
@@ -115,7 +116,9 @@ fn ci() -> Result<(), String> {
         "--no-default-features",
         "--release",
     ])?;
-    cargo(&["test", "--workspace", "--release"])
+    cargo(&["test", "--workspace", "--release"])?;
+    // A kernel from outside the workspace runs built-in scenes through the runner.
+    cargo(&["run", "--release", "--example", "custom_kernel"])
 }
 
 /// What `cargo xtask bench` was asked for.

@@ -3,11 +3,16 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
 use clap::{Parser, Subcommand};
-use umls_cli::builtin::BUILTIN;
-use umls_cli::run::{RunOptions, run};
-use umls_cli::scene::Scene;
-use umls_cli::schema::KernelKind;
+use umls_runner::builtin::BUILTIN;
+use umls_runner::schema::KernelKind;
+use umls_runner::{RunOptions, RunReport, Scene, run};
+
+mod mesh_info;
+mod progress;
 
 /// UMLS-MPM: material point methods on unstructured simplicial meshes.
 #[derive(Debug, Parser)]
@@ -24,10 +29,11 @@ enum Command {
         /// A built-in scene name (see `umls scenes`) or the path of a TOML scene file.
         scene: String,
         /// Shape-function kernel (default: the scene's).
-        #[arg(long, value_enum)]
-        kernel: Option<KernelKind>,
-        /// Output directory (default: out/SCENE-KERNEL); the files of an earlier run
-        /// there are replaced.
+        #[arg(long, value_parser = kernel_names())]
+        kernel: Option<String>,
+        /// Output directory (default: out/SCENE-KERNEL, with a short tag of the edits
+        /// when `--set`, `--refine` or `--particle-refine` change the scene); the files
+        /// of an earlier run there are replaced.
         #[arg(long)]
         out: Option<PathBuf>,
         /// Simulated time (default: the scene's).
@@ -42,7 +48,7 @@ enum Command {
         /// Replace a value of the scene before it is read, e.g. `--set time.cfl=0.5`,
         /// `--set mesh.lattice.jitter=0.3`, `--set bodies.0.seeding.lattice=0.025`
         /// (repeatable; the value is TOML, or else a string).
-        #[arg(long = "set", value_name = "KEY=VALUE", value_parser = umls_cli::edit::parse_assignment)]
+        #[arg(long = "set", value_name = "KEY=VALUE", value_parser = umls_runner::edit::parse_assignment)]
         set: Vec<(String, String)>,
         /// Divide every length of the discretisation by this factor: lattice cells,
         /// particle spacing, B-spline grid spacing and a fixed time step.
@@ -109,7 +115,7 @@ fn main() -> ExitCode {
             baseline,
             keep_frames,
         ),
-        Command::MeshInfo { file } => umls_cli::mesh_info::mesh_info(&file)
+        Command::MeshInfo { file } => mesh_info::mesh_info(&file)
             .map(|r| print!("{r}"))
             .map_err(Failure::from),
         Command::Run {
@@ -122,64 +128,17 @@ fn main() -> ExitCode {
             set,
             refine,
             particle_refine,
-        } => Scene::load_with(&scene, &set)
-            .map_err(Failure::from)
-            .and_then(|mut scene| {
-                if let Some(factor) = refine {
-                    umls_cli::edit::refine(&mut scene, factor)?;
-                }
-                if let Some(factor) = particle_refine {
-                    umls_cli::edit::refine_particles(&mut scene, factor)?;
-                }
-                // One folder per scene and kernel, so comparisons do not overwrite each other.
-                let kernel_name = kernel.unwrap_or(scene.spec.kernel.kind).name();
-                let out = out.unwrap_or_else(|| {
-                    PathBuf::from("out").join(format!("{}-{kernel_name}", scene.spec.scene.name))
-                });
-                // Ctrl-C stops the run after the current step and still writes its output
-                // and summary; a second Ctrl-C (or a failed handler) ends the process as usual.
-                let interrupt = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-                let flag = interrupt.clone();
-                let handler = ctrlc::set_handler(move || {
-                    if flag.swap(true, std::sync::atomic::Ordering::Relaxed) {
-                        std::process::exit(130);
-                    }
-                });
-                let options = RunOptions {
-                    kernel,
-                    out,
-                    end_time,
-                    threads,
-                    progress: !quiet,
-                    interrupt: handler.is_ok().then_some(interrupt),
-                };
-                let report = run(&scene, &options)?;
-                let s = &report.summary;
-                println!(
-                    "{}: {} steps of {} particles with {} in {:.2} s ({:.3e} particle-steps/s)",
-                    s["scene"].as_str().unwrap_or(""),
-                    s["steps"],
-                    s["particles"],
-                    s["kernel"].as_str().unwrap_or(""),
-                    s["wall_time_s"].as_f64().unwrap_or(0.0),
-                    s["particle_steps_per_second"].as_f64().unwrap_or(0.0),
-                );
-                if let Some(metrics) = s["metrics"].as_object() {
-                    for (k, v) in metrics {
-                        println!("  {k}: {v}");
-                    }
-                }
-                let background = if report.summary["outputs"]["mesh"].is_null() {
-                    "grid.vtu"
-                } else {
-                    "mesh.vtu"
-                };
-                println!(
-                    "wrote {} (open particles.pvd and {background} in ParaView)",
-                    report.out.display()
-                );
-                Ok(())
-            }),
+        } => run_scene(RunArgs {
+            scene,
+            kernel: kernel.as_deref().and_then(KernelKind::from_name),
+            out,
+            end_time,
+            threads,
+            quiet,
+            set,
+            refine,
+            particle_refine,
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -194,14 +153,133 @@ fn main() -> ExitCode {
     }
 }
 
+/// The kernel names `--kernel` accepts.
+fn kernel_names() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(KernelKind::ALL.map(KernelKind::name))
+}
+
+/// `umls run`'s arguments.
+struct RunArgs {
+    scene: String,
+    kernel: Option<KernelKind>,
+    out: Option<PathBuf>,
+    end_time: Option<f64>,
+    threads: Option<usize>,
+    quiet: bool,
+    set: Vec<(String, String)>,
+    refine: Option<f64>,
+    particle_refine: Option<f64>,
+}
+
+/// `umls run`: loads and edits the scene, runs it with output, prints what it measured.
+fn run_scene(args: RunArgs) -> Result<(), Failure> {
+    let mut scene = Scene::load_with(&args.scene, &args.set)?;
+    if let Some(factor) = args.refine {
+        umls_runner::edit::refine(&mut scene, factor)?;
+    }
+    if let Some(factor) = args.particle_refine {
+        umls_runner::edit::refine_particles(&mut scene, factor)?;
+    }
+    let kernel_name = args.kernel.unwrap_or(scene.spec.kernel.kind).name();
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_out(&scene.spec.scene.name, kernel_name, &args));
+    let options = RunOptions {
+        kernel: args.kernel,
+        out: Some(out),
+        end_time: args.end_time,
+        threads: args.threads,
+        progress: Some(Arc::new(progress::Bar::new(!args.quiet))),
+        interrupt: interrupt_on_signals(),
+    };
+    let report = run(&scene, &options)?;
+    print_report(&report);
+    Ok(())
+}
+
+/// One folder per scene, kernel and set of edits, so that comparisons and edited runs
+/// do not overwrite each other: `out/SCENE-KERNEL`, and `-EDITS` with a short tag of the
+/// edits (`--set`, `--refine`, `--particle-refine`, in the order given) when there are
+/// any.
+fn default_out(scene: &str, kernel: &str, args: &RunArgs) -> PathBuf {
+    let mut edits: Vec<String> = args.set.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    edits.extend(args.refine.map(|f| format!("refine={f}")));
+    edits.extend(args.particle_refine.map(|f| format!("particle-refine={f}")));
+    let name = if edits.is_empty() {
+        format!("{scene}-{kernel}")
+    } else {
+        format!(
+            "{scene}-{kernel}-{:08x}",
+            fnv1a(edits.join("\n").as_bytes()) as u32
+        )
+    };
+    PathBuf::from("out").join(name)
+}
+
+/// The 64-bit FNV-1a hash: a stable tag for a folder name, the same on every platform
+/// and release (the standard library's hasher promises neither).
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+/// SIGINT (Ctrl-C) and SIGTERM (a scheduler's or `kill`'s) stop the run after the
+/// current step, and its output and summary are still written. A second signal changes
+/// nothing, so a summary is written however impatient the user is; a third ends the
+/// process at once, for a step that does not finish. `None` where no handler could be
+/// installed.
+fn interrupt_on_signals() -> Option<Arc<AtomicBool>> {
+    let interrupt = Arc::new(AtomicBool::new(false));
+    let flag = interrupt.clone();
+    let signals = AtomicUsize::new(0);
+    let handler = ctrlc::set_handler(move || {
+        flag.store(true, Ordering::Relaxed);
+        if signals.fetch_add(1, Ordering::Relaxed) >= 2 {
+            std::process::exit(130);
+        }
+    });
+    handler.is_ok().then_some(interrupt)
+}
+
+/// What a finished run prints: the warnings, the throughput, the metrics, the folder.
+fn print_report(report: &RunReport) {
+    let s = &report.summary;
+    println!(
+        "{}: {} steps of {} particles with {} in {:.2} s ({:.3e} particle-steps/s stepping, {:.3e} with output)",
+        s.scene,
+        s.steps,
+        s.particles,
+        s.kernel,
+        s.wall_time_s,
+        s.particle_steps_per_second,
+        s.particle_steps_per_wall_second,
+    );
+    for (k, v) in &s.metrics {
+        println!("  {k}: {v}");
+    }
+    if let Some(out) = &report.out {
+        let background = if s.outputs.as_ref().is_some_and(|o| o.mesh.is_none()) {
+            "grid.vtu"
+        } else {
+            "mesh.vtu"
+        };
+        println!(
+            "wrote {} (open particles.pvd and {background} in ParaView)",
+            out.display()
+        );
+    }
+}
+
 /// Why a command failed: a run or scene, or the report around the runs.
 enum Failure {
-    Cli(umls_cli::CliError),
+    Cli(umls_runner::RunError),
     Report(umls_report::ReportError),
 }
 
-impl From<umls_cli::CliError> for Failure {
-    fn from(e: umls_cli::CliError) -> Self {
+impl From<umls_runner::RunError> for Failure {
+    fn from(e: umls_runner::RunError) -> Self {
         Failure::Cli(e)
     }
 }

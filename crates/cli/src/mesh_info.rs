@@ -5,7 +5,7 @@ use std::path::Path;
 
 use umls_io::gmsh::{AnyGmshMesh, GmshMesh, ReadOptions, read_msh_any};
 
-use crate::error::{CliError, Result};
+use umls_runner::{Result, RunError};
 
 fn report<const D: usize>(m: &GmshMesh<D>, path: &Path) -> String {
     let mut out = String::new();
@@ -60,7 +60,7 @@ fn report<const D: usize>(m: &GmshMesh<D>, path: &Path) -> String {
 /// The report for the mesh file at `path`.
 pub fn mesh_info(path: &Path) -> Result<String> {
     // The reader's errors name the line or byte; the file is named here.
-    let mesh = read_msh_any(path, ReadOptions::default()).map_err(|e| CliError::MeshFile {
+    let mesh = read_msh_any(path, ReadOptions::default()).map_err(|e| RunError::MeshFile {
         file: path.display().to_string(),
         message: e.to_string(),
     })?;

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 use std::time::Duration;
 
-use umls_cli::builtin::BUILTIN;
+use umls_runner::builtin::BUILTIN;
 
 mod common;
 

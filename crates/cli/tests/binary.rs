@@ -383,9 +383,9 @@ fn scenes_and_help() {
     let text = String::from_utf8_lossy(&out.stdout);
     // Every built-in scene, one line each, the summaries in one column.
     let lines: Vec<&str> = text.lines().collect();
-    assert_eq!(lines.len(), umls_cli::builtin::BUILTIN.len());
+    assert_eq!(lines.len(), umls_runner::builtin::BUILTIN.len());
     let mut columns = std::collections::BTreeSet::new();
-    for (line, b) in lines.iter().zip(umls_cli::builtin::BUILTIN) {
+    for (line, b) in lines.iter().zip(umls_runner::builtin::BUILTIN) {
         assert!(line.starts_with(&format!("{}  ", b.name)), "{text}");
         columns.insert(line.find(b.summary).expect("the summary is listed"));
     }
@@ -443,7 +443,7 @@ fn mesh_info_reports_and_fails_clearly() {
 
     // A scene whose mesh file is missing names the scene, the key and the path.
     let scene = dir.join("scene.toml");
-    let text = umls_cli::builtin::BUILTIN[2].toml.replacen(
+    let text = umls_runner::builtin::BUILTIN[2].toml.replacen(
         "file = \"meshes/cantilever.msh\"",
         "file = \"meshes/missing.msh\"",
         1,
@@ -477,7 +477,7 @@ fn bad_scene_names_and_keys_fail_clearly() {
     let dir = scratch("bad-key");
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("typo.toml");
-    let text = umls_cli::builtin::BUILTIN[0]
+    let text = umls_runner::builtin::BUILTIN[0]
         .toml
         .replacen("[output]", "[output]\nframe = 3", 1);
     std::fs::write(&file, text).unwrap();
@@ -498,7 +498,7 @@ fn an_unstable_run_leaves_its_history_and_says_why() {
     let dir = scratch("unstable");
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("unstable.toml");
-    let text = umls_cli::builtin::BUILTIN[0]
+    let text = umls_runner::builtin::BUILTIN[0]
         .toml
         .replacen("dt = 1e-3", "dt = 0.2", 1)
         .replacen("alpha = 0.99", "alpha = 1.0", 1);
@@ -854,7 +854,7 @@ velocity = ["y", "-x"]
 fn bad_values_fail_fast_and_name_their_key() {
     let dir = scratch("bad-values");
     std::fs::create_dir_all(&dir).unwrap();
-    let disks = umls_cli::builtin::BUILTIN[0].toml;
+    let disks = umls_runner::builtin::BUILTIN[0].toml;
     let edit = |find: &str, replace: &str| Some(disks.replacen(find, replace, 1));
     /// Case name, scene text (`None`: the directory itself), extra arguments, what the
     /// message must say, what it must not say.
@@ -968,7 +968,7 @@ fn a_clipped_body_is_reported() {
     let dir = scratch("clipped");
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("clipped.toml");
-    let text = umls_cli::builtin::BUILTIN[0].toml.replacen(
+    let text = umls_runner::builtin::BUILTIN[0].toml.replacen(
         "centre = [0.2, 0.2], radius = 0.2",
         "centre = [0.0, 0.2], radius = 0.2",
         1,

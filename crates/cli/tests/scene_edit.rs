@@ -3,9 +3,9 @@
 
 use std::process::Command;
 
-use umls_cli::edit::{override_text, parse_assignment, refine, refine_particles};
-use umls_cli::scene::Scene;
-use umls_cli::schema::SeedingSpec;
+use umls_runner::edit::{override_text, parse_assignment, refine, refine_particles};
+use umls_runner::scene::Scene;
+use umls_runner::schema::SeedingSpec;
 
 const TEXT: &str = "[scene]\nname = \"s\"\n[time]\ncfl = 0.3\n[[bodies]]\nmaterial = \"a\"\n[[boundaries]]\nkind = \"fixed\"\n[[boundaries]]\nkind = \"slip\"\n";
 

@@ -83,6 +83,6 @@ pub use settings::{Damping, MassMatrix, StencilStorage, StepSettings, TimeStepCo
 pub use simulation::{BodyForce, Simulation};
 pub use timing::StageTimes;
 pub use transfer::{
-    Apic, ApicFlip, Flip, MlsMpm, Pic, QuadraticApic, QuadraticApicFlip, SingularSecondMoment,
-    StressUpdate, TransferScheme, VelocityGradientAffine,
+    AffineTransfer, Apic, ApicFlip, Flip, MlsMpm, Pic, QuadraticApic, QuadraticApicFlip,
+    SingularSecondMoment, StressUpdate, TransferScheme, VelocityGradientAffine,
 };

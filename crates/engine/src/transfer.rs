@@ -406,3 +406,54 @@ mod tests {
         );
     }
 }
+
+/// APIC or the velocity-gradient affine transfer, chosen at run time. Both carry C_p; the
+/// moments B_p and D_p are accumulated for both although only APIC reads them (a few
+/// flops per node, against a second copy of every simulation type of a program that offers
+/// both).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AffineTransfer {
+    /// [`Apic`].
+    Apic,
+    /// [`VelocityGradientAffine`].
+    VelocityGradient,
+}
+
+impl TransferScheme for AffineTransfer {
+    const AFFINE: bool = true;
+    const USES_MOMENTS: bool = true;
+
+    fn name(&self) -> &'static str {
+        match self {
+            Self::Apic => Apic.name(),
+            Self::VelocityGradient => VelocityGradientAffine.name(),
+        }
+    }
+
+    fn affine<const D: usize>(
+        &self,
+        b: &SMatrix<f64, D, D>,
+        d: &SMatrix<f64, D, D>,
+        grad_v: &SMatrix<f64, D, D>,
+    ) -> SMatrix<f64, D, D> {
+        match self {
+            Self::Apic => Apic.affine(b, d, grad_v),
+            Self::VelocityGradient => VelocityGradientAffine.affine(b, d, grad_v),
+        }
+    }
+
+    fn affine_with_constant_moment<const D: usize>(
+        &self,
+        b: &SMatrix<f64, D, D>,
+        s: f64,
+        grad_v: &SMatrix<f64, D, D>,
+    ) -> SMatrix<f64, D, D> {
+        // Each scheme's own closed form (APIC: B_p / s, no Cholesky factorisation).
+        match self {
+            Self::Apic => Apic.affine_with_constant_moment(b, s, grad_v),
+            Self::VelocityGradient => {
+                VelocityGradientAffine.affine_with_constant_moment(b, s, grad_v)
+            }
+        }
+    }
+}

@@ -1,9 +1,9 @@
 //! The hydrostatic-column scenes: their metrics against the closed form, the metrics
 //! themselves against an exactly known state, and a turned scene against the upright one.
 
-use umls_cli::run::run;
-use umls_cli::scene::Scene;
-use umls_cli::schema::KernelKind;
+use umls_runner::run::run;
+use umls_runner::scene::Scene;
+use umls_runner::schema::KernelKind;
 
 #[path = "common/runs.rs"]
 mod runs;
@@ -15,6 +15,7 @@ fn column_with(kernel: KernelKind, name: &str) -> serde_json::Value {
     run(&scene, &options(name, Some(kernel), None))
         .unwrap()
         .summary
+        .to_json()
 }
 
 /// Particles that start at the geostatic stress of the exact solution: one short step
@@ -42,7 +43,7 @@ fn metrics_read_the_exact_state_as_exact() {
             ),
         )
         .unwrap();
-        let s = &report.summary;
+        let s = &report.summary.to_json();
         // The geostatic depth is measured from the top of the top particles, which is
         // the column's surface: the initial stress is the exact one (Newton's method
         // solves the pre-strain to ~1e-10 relative).
@@ -68,7 +69,7 @@ fn bspline_column_settles_at_the_closed_form() {
         &options("column-bspline2", Some(KernelKind::Bspline2), None),
     )
     .unwrap();
-    let s = &report.summary;
+    let s = &report.summary.to_json();
     assert!(metric(s, "stress_rms") < 0.01, "{s}");
     assert!((metric(s, "bottom_row_ratio") - 1.0).abs() < 0.07, "{s}");
     assert!(
@@ -78,7 +79,7 @@ fn bspline_column_settles_at_the_closed_form() {
     assert!((metric(s, "settlement_ratio") - 1.0).abs() < 0.07, "{s}");
     // The walls' reactions at rest: the base carries the weight ρgHW = 40 kN, each side
     // wall the lateral thrust K0 ρ g H² / 2 = 34.3 kN (per unit depth).
-    let history = History::read(&report.out);
+    let history = History::read(report.out.as_deref().unwrap());
     let column = |name: &str| history.last(name);
     let weight = 1000.0 * 10.0 * 4.0;
     assert!(
@@ -106,7 +107,7 @@ fn bspline_column_settles_at_the_closed_form() {
 fn turned_column_on_its_mesh_is_the_upright_column() {
     let metrics = |scene: &Scene, name: &str| {
         let report = run(scene, &options(name, Some(KernelKind::LinearFe), None)).unwrap();
-        report.summary["metrics"].clone()
+        report.summary.to_json()["metrics"].clone()
     };
     let keys = ["stress_rms", "bottom_row_ratio", "k0", "settlement_ratio"];
     let mass = "[damping]\nmass = 100.0";
@@ -173,7 +174,7 @@ fn consistent_mass_keeps_the_column_on_its_walls() {
             &options(&format!("column-umls-mass-{}", mass.len()), None, None),
         )
         .unwrap();
-        let s = report.summary;
+        let s = report.summary.to_json();
         (
             metric(&s, "stress_rms"),
             metric(&s, "bottom_row_ratio"),
@@ -210,9 +211,9 @@ fn kernel_support_keys_override_the_preset() {
     let report = run(&narrow, &options("column-umls-narrow", None, None)).unwrap();
     // Measured 0.0046 (0.0046 without the integration correction too).
     assert!(
-        metric(&report.summary, "stress_rms") < 0.01,
+        metric(&report.summary.to_json(), "stress_rms") < 0.01,
         "{}",
-        report.summary
+        report.summary.to_json()
     );
     let bad = variant(
         "hydrostatic-column",
@@ -257,8 +258,8 @@ fn the_diminishing_exponent_key_gives_the_eta4_kernel() {
         &options("column-eta4-name", Some(KernelKind::UmlsEta4), end),
     )
     .unwrap();
-    assert_eq!(named.summary["kernel"], "umls-eta4");
-    let rms = |r: &umls_cli::run::RunReport| metric(&r.summary, "stress_rms");
+    assert_eq!(named.summary.to_json()["kernel"], "umls-eta4");
+    let rms = |r: &umls_runner::run::RunReport| metric(&r.summary.to_json(), "stress_rms");
     assert_eq!(rms(&keyed).to_bits(), rms(&named).to_bits());
     let plain = run(
         &Scene::load("hydrostatic-column").unwrap(),
@@ -311,7 +312,7 @@ fn full_gradient_meets_the_gmsh_tetrahedra_column_and_the_gradient_key_selects_i
         ),
     )
     .unwrap();
-    let s = &report.summary;
+    let s = &report.summary.to_json();
     assert_eq!(s["kernel"], "umls-full-gradient");
     assert!(metric(s, "stress_rms") <= 0.05, "{s}");
     assert!((metric(s, "bottom_row_ratio") - 1.0).abs() < 0.1, "{s}");
@@ -328,7 +329,7 @@ fn full_gradient_meets_the_gmsh_tetrahedra_column_and_the_gradient_key_selects_i
     );
     assert_eq!(reverted.to_bits(), plain.to_bits());
     assert_ne!(
-        metric(&keyed.summary, "stress_rms").to_bits(),
+        metric(&keyed.summary.to_json(), "stress_rms").to_bits(),
         plain.to_bits()
     );
 }
@@ -341,7 +342,7 @@ fn short_rms(name: &str, kernel_lines: &str, kind: KernelKind) -> (f64, f64) {
     let tag = format!("{name}-{}", kind.name());
     let edited = run(&edited, &options(&format!("{tag}-edited"), None, end)).unwrap();
     let named = run(&Scene::load(name).unwrap(), &options(&tag, Some(kind), end)).unwrap();
-    let rms = |r: &umls_cli::run::RunReport| metric(&r.summary, "stress_rms");
+    let rms = |r: &umls_runner::run::RunReport| metric(&r.summary.to_json(), "stress_rms");
     (rms(&edited), rms(&named))
 }
 
@@ -377,7 +378,7 @@ fn frozen_eta_gradient_beats_bspline2_on_the_2d_columns() {
             ),
         )
         .unwrap();
-        let (s, b) = (&frozen.summary, &grid.summary);
+        let (s, b) = (&frozen.summary.to_json(), &grid.summary.to_json());
         assert_eq!(s["kernel"], "umls-frozen-eta");
         assert!(
             metric(s, "stress_rms") < metric(b, "stress_rms"),
@@ -399,7 +400,7 @@ fn frozen_eta_gradient_beats_bspline2_on_the_2d_columns() {
 /// Runs the 2D column for 0.3 s with `[kernel] gradient = key` on `umls-uncorrected` (the
 /// kernel the other names vary) and with the kernel name `kind`, asserts the same bits,
 /// and returns the keyed run.
-fn same_with_key_as_name(key: &str, kind: KernelKind) -> umls_cli::run::RunReport {
+fn same_with_key_as_name(key: &str, kind: KernelKind) -> umls_runner::run::RunReport {
     let end = Some(0.3);
     let by_key = variant(
         "hydrostatic-column",
@@ -418,7 +419,7 @@ fn same_with_key_as_name(key: &str, kind: KernelKind) -> umls_cli::run::RunRepor
         &options(&format!("column-umls-{key}-name"), Some(kind), end),
     )
     .unwrap();
-    let rms = |r: &umls_cli::run::RunReport| metric(&r.summary, "stress_rms");
+    let rms = |r: &umls_runner::run::RunReport| metric(&r.summary.to_json(), "stress_rms");
     assert_eq!(rms(&keyed).to_bits(), rms(&named).to_bits(), "{key}");
     keyed
 }
@@ -440,7 +441,7 @@ fn integration_correction_meets_every_column_target() {
     ] {
         let scene = Scene::load(name).unwrap();
         let corrected = run(&scene, &options(&format!("{name}-umls"), None, None)).unwrap();
-        let s = &corrected.summary;
+        let s = &corrected.summary.to_json();
         assert_eq!(s["kernel"], "umls");
         assert!(metric(s, "stress_rms") <= target, "{name}: {s}");
         assert!(
@@ -462,9 +463,9 @@ fn integration_correction_meets_every_column_target() {
             )
             .unwrap();
             assert!(
-                metric(s, "stress_rms") < 0.5 * metric(&plain.summary, "stress_rms"),
+                metric(s, "stress_rms") < 0.5 * metric(&plain.summary.to_json(), "stress_rms"),
                 "{name}: {s} against {}",
-                plain.summary
+                plain.summary.to_json()
             );
         }
     }

@@ -19,7 +19,7 @@ use crate::error::Result;
 use crate::frame::SceneFrame;
 use crate::scene::Scene;
 use crate::schema::{HydrostaticSpec, MaterialSpec, SeedingSpec};
-use crate::setup::Seeds;
+use crate::seeds::Seeds;
 
 /// The column's closed form, resolved against the scene.
 #[derive(Debug, Clone)]

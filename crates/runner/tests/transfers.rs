@@ -1,8 +1,8 @@
 //! Transfer schemes on the colliding disks: what APIC-FLIP (APIC's affine P2G with
 //! FLIP's velocity update) keeps against FLIP at the same blend.
 
-use umls_cli::run::run;
-use umls_cli::schema::KernelKind;
+use umls_runner::run::run;
+use umls_runner::schema::KernelKind;
 
 #[path = "common/runs.rs"]
 mod runs;
@@ -16,11 +16,12 @@ fn disks_with(kernel: KernelKind, kind: &str, prefix: &str, refine: f64) -> serd
         "colliding-disks",
         &[("kind = \"flip\"", &format!("kind = \"{kind}\""))],
     );
-    umls_cli::edit::refine(&mut scene, refine).unwrap();
+    umls_runner::edit::refine(&mut scene, refine).unwrap();
     let name = format!("{prefix}-{}-{kind}", kernel.name());
     run(&scene, &options(&name, Some(kernel), None))
         .unwrap()
         .summary
+        .to_json()
 }
 
 /// The fraction of the disks' energy lost by t = 3 with `kernel`, transfer `kind` and
@@ -71,8 +72,11 @@ fn consistent_mass_keeps_the_disks_energy_under_apic() {
         let name = format!("disks-{}-apic-{}", kernel.name(), mass.len());
         let report = run(&scene, &options(&name, Some(kernel), None)).unwrap();
         (
-            -metric(&report.summary, "energy_change_final"),
-            report.summary["transfer"].as_str().unwrap().to_owned(),
+            -metric(&report.summary.to_json(), "energy_change_final"),
+            report.summary.to_json()["transfer"]
+                .as_str()
+                .unwrap()
+                .to_owned(),
         )
     };
     for kernel in [KernelKind::Umls, KernelKind::Bspline2] {
@@ -125,8 +129,11 @@ fn a_forces_share_between_lumped_and_consistent_is_read_and_checked() {
     let rmse = |forces: &str| -> (f64, String) {
         let report = bar(forces).unwrap();
         (
-            metric(&report.summary, "velocity_rmse"),
-            report.summary["transfer"].as_str().unwrap().to_owned(),
+            metric(&report.summary.to_json(), "velocity_rmse"),
+            report.summary.to_json()["transfer"]
+                .as_str()
+                .unwrap()
+                .to_owned(),
         )
     };
     let (lumped, name) = rmse("false");
@@ -152,7 +159,7 @@ fn a_forces_share_between_lumped_and_consistent_is_read_and_checked() {
             "kind = \"apic\"\nmass = { iterations = 2, forces = \"yes\" }",
         )],
     );
-    let refused = umls_cli::scene::Scene::parse(&text, "bar.toml", None)
+    let refused = umls_runner::scene::Scene::parse(&text, "bar.toml", None)
         .unwrap_err()
         .to_string();
     assert!(
@@ -265,8 +272,13 @@ fn the_energy_umls_loses_beyond_bspline2_on_the_disks_leaves_in_the_collision() 
     let summary = |kernel: KernelKind, end_time: f64| {
         let name = format!("disks-bulk-{}-{end_time}", kernel.name());
         let report = run(&scene, &options(&name, Some(kernel), Some(end_time))).unwrap();
-        assert_eq!(report.summary["status"], "completed", "{}", report.summary);
-        report.summary
+        assert_eq!(
+            report.summary.to_json()["status"],
+            "completed",
+            "{}",
+            report.summary.to_json()
+        );
+        report.summary.to_json()
     };
     let velocity = |s: &serde_json::Value, body: usize| -> [f64; 2] {
         let v = &s["metrics"]["body_velocities"][body];

@@ -3,9 +3,9 @@
 //! of the reference position (the vortex), a velocity reference and a probe (the
 //! cantilever's tip) give what they give unsorted.
 
-use umls_cli::run::run;
-use umls_cli::scene::Scene;
-use umls_cli::schema::KernelKind;
+use umls_runner::run::run;
+use umls_runner::scene::Scene;
+use umls_runner::schema::KernelKind;
 
 #[path = "common/runs.rs"]
 mod runs;
@@ -31,7 +31,7 @@ fn unsorted_and_sorted(name: &str, kernel: KernelKind, end_time: f64) -> (Histor
             Some(end_time),
         );
         let report = run(&scene, &options).unwrap();
-        let s = &report.summary;
+        let s = &report.summary.to_json();
         assert_eq!(s["status"], "completed", "{s}");
         assert_eq!(s["particle_sort_interval"], interval, "{s}");
         let sorts = s["particle_sorts"].as_u64().unwrap();
@@ -39,7 +39,7 @@ fn unsorted_and_sorted(name: &str, kernel: KernelKind, end_time: f64) -> (Histor
         // A sort before every second step from the second on.
         let expected = if interval == 0 { 0 } else { (steps - 1) / 2 };
         assert_eq!(sorts, expected, "{name}: {steps} steps");
-        histories.push(History::read(&options.out));
+        histories.push(History::read(options.out.as_deref().unwrap()));
     }
     let sorted = histories.pop().unwrap();
     (histories.pop().unwrap(), sorted)

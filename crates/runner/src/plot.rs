@@ -6,7 +6,7 @@ use std::path::Path;
 
 use umls_io::chart::{Axis, LineChart, Series};
 
-use crate::error::{CliError, Result};
+use crate::error::{Result, RunError};
 
 /// Energies at one recorded time.
 #[derive(Debug, Clone, Copy)]
@@ -56,7 +56,7 @@ pub fn energy_plot(
         series,
     }
     .write_svg(path)
-    .map_err(|e| CliError::Plot {
+    .map_err(|e| RunError::Plot {
         path: path.to_path_buf(),
         message: e.to_string(),
     })

@@ -173,7 +173,7 @@ pub struct LatticeSpec {
 }
 
 /// Kernel names.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum KernelKind {
     /// C¹ UMLS kernel on the mesh: linear basis, cubic B-spline weights with the
@@ -232,6 +232,30 @@ pub enum KernelKind {
 }
 
 impl KernelKind {
+    /// Every preset, in the order the command line lists them.
+    pub const ALL: [KernelKind; 15] = [
+        KernelKind::Umls,
+        KernelKind::UmlsQuadratic,
+        KernelKind::UmlsWendland,
+        KernelKind::UmlsSharp,
+        KernelKind::UmlsWide,
+        KernelKind::UmlsPaper,
+        KernelKind::UmlsFullGradient,
+        KernelKind::UmlsFrozenEta,
+        KernelKind::UmlsUncorrected,
+        KernelKind::UmlsEta4,
+        KernelKind::UmlsEta8,
+        KernelKind::UmlsElementSize,
+        KernelKind::LinearFe,
+        KernelKind::Bspline2,
+        KernelKind::Bspline3,
+    ];
+
+    /// The preset named `name` (as in scene files and on the command line).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
     /// The name used in scene files and on the command line.
     pub fn name(self) -> &'static str {
         match self {

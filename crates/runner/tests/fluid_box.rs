@@ -1,9 +1,9 @@
 //! The `fluid-box-3d` scene (Taichi's mpm3d) and the grid kernels' lean background: a
 //! B-spline run of a `[mesh.lattice]` scene never splits the lattice into simplices.
 
-use umls_cli::run::run;
-use umls_cli::scene::Scene;
-use umls_cli::setup::{build, build_for, tetrahedra, triangles};
+use umls_runner::run::run;
+use umls_runner::scene::Scene;
+use umls_runner::setup::{build, build_for, tetrahedra, triangles};
 
 #[path = "common/runs.rs"]
 mod runs;
@@ -24,8 +24,8 @@ fn fluid_box_falls_freely_at_first_without_a_mesh() {
     let scene = Scene::load_with("fluid-box-3d", &with_few_frames(Vec::new())).unwrap();
     let options = options("fluid-box", None, Some(0.005));
     let report = run(&scene, &options).unwrap();
-    let out = options.out.clone();
-    let s = &report.summary;
+    let out = options.out.clone().unwrap();
+    let s = &report.summary.to_json();
     assert_eq!(s["kernel"], "bspline2");
     assert_eq!(s["particles"], 64_000);
     assert_eq!(s["steps"], 25);
@@ -62,8 +62,13 @@ fn fluid_box_falls_freely_under_mls_mpm_on_any_thread_count() {
         let mut options = options(&format!("fluid-box-mls-mpm-{threads}"), None, Some(0.005));
         options.threads = Some(threads);
         let report = run(&scene, &options).unwrap();
-        assert_eq!(report.summary["transfer"], "mls-mpm", "{}", report.summary);
-        let history = History::read(&options.out);
+        assert_eq!(
+            report.summary.to_json()["transfer"],
+            "mls-mpm",
+            "{}",
+            report.summary.to_json()
+        );
+        let history = History::read(options.out.as_deref().unwrap());
         let mass = history.last("mass");
         let expected = -mass * 9.8 * history.last("time");
         let momentum = history.last("momentum_y");
@@ -71,7 +76,9 @@ fn fluid_box_falls_freely_under_mls_mpm_on_any_thread_count() {
             (momentum - expected).abs() < 1e-10 * expected.abs(),
             "{momentum} vs {expected}"
         );
-        histories.push(std::fs::read_to_string(options.out.join("history.csv")).unwrap());
+        histories.push(
+            std::fs::read_to_string(options.out.as_deref().unwrap().join("history.csv")).unwrap(),
+        );
     }
     assert_eq!(histories[0], histories[1]);
 }
@@ -128,15 +135,17 @@ fn factored_umls_stencils_give_the_stored_run_in_less_memory() {
         .unwrap();
         let options = options(
             &format!("fluid-box-umls-{storage}"),
-            Some(umls_cli::schema::KernelKind::Umls),
+            Some(umls_runner::schema::KernelKind::Umls),
             Some(0.05),
         );
         let report = run(&scene, &options).unwrap();
-        let s = &report.summary;
+        let s = &report.summary.to_json();
         assert_eq!(s["stencils"], storage, "{s}");
         assert_eq!(s["status"], "completed", "{s}");
         stored_bytes.push(s["engine_memory"]["stored_stencil_bytes"].as_f64().unwrap());
-        histories.push(std::fs::read_to_string(options.out.join("history.csv")).unwrap());
+        histories.push(
+            std::fs::read_to_string(options.out.as_deref().unwrap().join("history.csv")).unwrap(),
+        );
     }
     assert!(histories[0].lines().count() > 200);
     assert_eq!(histories[0], histories[1]);

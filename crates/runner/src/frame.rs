@@ -45,7 +45,7 @@ impl<const D: usize> SceneFrame<D> {
         }
         let centre = match &t.centre {
             None => SVector::zeros(),
-            Some(c) => crate::setup::vector(scene, &format!("{key}.centre"), c)?,
+            Some(c) => scene.vector(&format!("{key}.centre"), c)?,
         };
         let angle = t.rotation.to_radians();
         let rotation = match D {
@@ -66,7 +66,7 @@ impl<const D: usize> SceneFrame<D> {
             3 => {
                 let axis: Vector3<f64> = match &t.axis {
                     None => Vector3::z(),
-                    Some(a) => crate::setup::vector(scene, &format!("{key}.axis"), a)?,
+                    Some(a) => scene.vector(&format!("{key}.axis"), a)?,
                 };
                 let Some(axis) = Unit::try_new(axis, 1e-300) else {
                     return Err(scene.value_error(format!("{key}.axis"), "must not be zero"));

@@ -1,12 +1,12 @@
 //! Scene files: the built-in ones build the same particles and give the same results as
 //! the hand-written scenes of `umls-scenes`; bad files fail naming the key.
 
-use umls_cli::CliError;
-use umls_cli::run::{RunOptions, run};
-use umls_cli::scene::Scene;
-use umls_cli::setup::{build, segments, triangles};
 use umls_engine::Apic;
 use umls_kernels::{Umls1, Umls2};
+use umls_runner::RunError;
+use umls_runner::run::{RunOptions, run};
+use umls_runner::scene::Scene;
+use umls_runner::setup::{build, segments, triangles};
 use umls_scenes::colliding_disks::CollidingDisks;
 use umls_scenes::vibrating_bar::VibratingBar;
 
@@ -16,12 +16,10 @@ use runs::variant_text;
 
 fn options(name: &str, end_time: Option<f64>) -> RunOptions {
     RunOptions {
-        kernel: None,
-        out: std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name),
+        out: Some(std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name)),
         end_time,
         threads: Some(2),
-        progress: false,
-        interrupt: None,
+        ..RunOptions::default()
     }
 }
 
@@ -64,7 +62,7 @@ fn disks_file_runs_like_the_hand_written_scene() {
         sim.step().unwrap();
     }
     let d = sim.diagnostics().unwrap();
-    let s = &report.summary;
+    let s = &report.summary.to_json();
     assert_eq!(s["steps"], 50);
     // Every stage is timed, inside the run's wall time, and the shares add up.
     assert_eq!(sim.stage_times().steps, 50);
@@ -94,12 +92,12 @@ fn disks_file_runs_like_the_hand_written_scene() {
 /// the energies match the library's own PIC to round-off.
 #[test]
 fn pic_from_a_file_is_the_library_pic() {
-    let text = umls_cli::builtin::BUILTIN[0].toml;
+    let text = umls_runner::builtin::BUILTIN[0].toml;
     let flip = "kind = \"flip\"\nalpha = 0.99";
     assert!(text.contains(flip));
     let scene = Scene::parse(&text.replacen(flip, "kind = \"pic\"", 1), "pic.toml", None).unwrap();
     let report = run(&scene, &options("disks-pic", Some(0.05))).unwrap();
-    assert_eq!(report.summary["transfer"], "pic");
+    assert_eq!(report.summary.to_json()["transfer"], "pic");
     let reference = CollidingDisks::default();
     let mesh = reference.shared_mesh().unwrap();
     let mut sim = reference
@@ -109,7 +107,9 @@ fn pic_from_a_file_is_the_library_pic() {
         sim.step().unwrap();
     }
     let expected = sim.diagnostics().unwrap().total_energy();
-    let found = report.summary["metrics"]["final_energy"].as_f64().unwrap();
+    let found = report.summary.to_json()["metrics"]["final_energy"]
+        .as_f64()
+        .unwrap();
     assert!(
         (found - expected).abs() < 1e-12 * expected,
         "{found} vs {expected}"
@@ -120,13 +120,15 @@ fn pic_from_a_file_is_the_library_pic() {
 fn bar_file_matches_the_hand_written_scene_error() {
     let scene = Scene::load("vibrating-bar").unwrap();
     let report = run(&scene, &options("bar-file", None)).unwrap();
-    let file_rmse = report.summary["metrics"]["velocity_rmse"].as_f64().unwrap();
+    let file_rmse = report.summary.to_json()["metrics"]["velocity_rmse"]
+        .as_f64()
+        .unwrap();
     let bar = VibratingBar {
         cells: 50,
         ..VibratingBar::default()
     };
     let (steps, _) = bar.steps_and_dt();
-    assert_eq!(report.summary["steps"], steps);
+    assert_eq!(report.summary.to_json()["steps"], steps);
     let mesh = std::sync::Arc::new(bar.mesh().unwrap());
     let expected = bar.run(Umls1::new(mesh), Apic).unwrap().velocity_rmse;
     assert!(
@@ -175,7 +177,9 @@ fn a_body_starts_its_affine_matrices_at_the_velocity_gradient() {
         assert!((got.1 - want.1).abs() < 1e-10 * largest, "{got:?} {want:?}");
     }
     let report = run(&scene, &options("bar-file-affine", None)).unwrap();
-    let file_rmse = report.summary["metrics"]["velocity_rmse"].as_f64().unwrap();
+    let file_rmse = report.summary.to_json()["metrics"]["velocity_rmse"]
+        .as_f64()
+        .unwrap();
     let mesh = std::sync::Arc::new(bar.mesh().unwrap());
     let started = bar
         .run(Umls1::new(mesh.clone()), Apic)
@@ -226,7 +230,7 @@ fn a_body_starts_its_affine_matrices_at_the_velocity_gradient() {
     assert!(first > 100 && second > 100, "{first} {second}");
 
     // Refused, naming the key.
-    let refused = |scene: Result<Scene, CliError>| {
+    let refused = |scene: Result<Scene, RunError>| {
         let message = match scene.and_then(|s| build::<1>(&s, segments).map(|_| ())) {
             Err(e) => e.to_string(),
             Ok(()) => panic!("accepted"),
@@ -254,7 +258,7 @@ fn with(text: &str, find: &str, replace: &str) -> Scene {
 }
 
 fn message(scene_name: &str, find: &str, replace: &str) -> String {
-    let builtin = umls_cli::builtin::BUILTIN
+    let builtin = umls_runner::builtin::BUILTIN
         .iter()
         .find(|b| b.name == scene_name)
         .unwrap();
@@ -552,7 +556,7 @@ fn group_conditions_reach_grid_kernels_as_a_staircase() {
     // but it carries the beam: the mean clamp force over the first 0.2 s is upward, and
     // the momentum M v stays below a free fall's M g t (0.66 of it measured; a rod
     // turning about a frictionless hinge reaches 0.75).
-    let text = umls_cli::builtin::BUILTIN
+    let text = umls_runner::builtin::BUILTIN
         .iter()
         .find(|b| b.name == "steel-cantilever")
         .unwrap()
@@ -560,7 +564,7 @@ fn group_conditions_reach_grid_kernels_as_a_staircase() {
         .replacen("kind = \"umls\"", "kind = \"bspline2\"", 1);
     let scene = Scene::parse(&text, "edited.toml", None).unwrap();
     let report = run(&scene, &options("cantilever-bspline", Some(0.2))).unwrap();
-    let text = std::fs::read_to_string(report.out.join("history.csv")).unwrap();
+    let text = std::fs::read_to_string(report.out.as_deref().unwrap().join("history.csv")).unwrap();
     let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
     let rows: Vec<Vec<f64>> = text
         .lines()
@@ -581,7 +585,7 @@ fn group_conditions_reach_grid_kernels_as_a_staircase() {
     let scene = with("steel-cantilever", "group = \"wall\"", "group = \"floor\"");
     let err = run(&scene, &options("cantilever-bspline-floor", Some(1e-3))).unwrap_err();
     assert!(
-        matches!(&err, CliError::SceneValue { key, .. } if key == "boundaries[0].group"),
+        matches!(&err, RunError::SceneValue { key, .. } if key == "boundaries[0].group"),
         "{err}"
     );
 }

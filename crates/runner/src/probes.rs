@@ -33,8 +33,7 @@ impl Probes {
     ) -> Result<Self> {
         let mut particles = Vec::new();
         for (k, point) in scene.spec.output.probes.iter().enumerate() {
-            let point: SVector<f64, D> =
-                crate::setup::vector(scene, &format!("output.probes[{k}]"), point)?;
+            let point: SVector<f64, D> = scene.vector(&format!("output.probes[{k}]"), point)?;
             let world = frame.point_to_world(&point);
             let nearest = initial
                 .iter()

@@ -7,11 +7,11 @@ use nalgebra::SVector;
 use serde_json::{Map, Value, json};
 
 use crate::error::Result;
+use crate::handle::Run;
 use crate::probes::Probes;
-use crate::run::Run;
 use crate::scene::Scene;
 use crate::schema::ProfileSpec;
-use crate::setup::{self, Setup};
+use crate::setup::Setup;
 
 /// The end-state metrics of `sim`; `initial` are the particles' initial (world)
 /// positions, `initial_energy` the run's initial mechanical energy. The column's
@@ -38,7 +38,7 @@ pub(crate) fn end_state<const D: usize>(
         ));
     }
     if let Some(direction) = &scene.spec.output.front {
-        let d: SVector<f64, D> = setup::vector(scene, "output.front", direction)?;
+        let d: SVector<f64, D> = scene.vector("output.front", direction)?;
         if d.norm() == 0.0 {
             return Err(scene.value_error("output.front", "must not be zero"));
         }
@@ -125,8 +125,8 @@ fn surface_profile<const D: usize>(
     sim: &dyn Run<D>,
     spec: &ProfileSpec,
 ) -> Result<Value> {
-    let along: SVector<f64, D> = setup::vector(scene, "output.profile.along", &spec.along)?;
-    let up: SVector<f64, D> = setup::vector(scene, "output.profile.up", &spec.up)?;
+    let along: SVector<f64, D> = scene.vector("output.profile.along", &spec.along)?;
+    let up: SVector<f64, D> = scene.vector("output.profile.up", &spec.up)?;
     if along.norm() == 0.0 || up.norm() == 0.0 {
         return Err(scene.value_error("output.profile", "`along` and `up` must not be zero"));
     }

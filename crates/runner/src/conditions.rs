@@ -6,8 +6,9 @@
 use nalgebra::SVector;
 use umls_engine::{FittedClamp, Wall, WallKind, face_points};
 
+use crate::context::Context;
 use crate::error::Result;
-use crate::run::{Context, Run};
+use crate::handle::Run;
 use crate::schema::{BoundaryKind, Imposed};
 use crate::setup::BoundaryTarget;
 
@@ -17,7 +18,7 @@ pub(crate) fn apply_boundaries<const D: usize>(
     sim: &mut dyn Run<D>,
 ) -> Result<()> {
     let scene = ctx.scene;
-    let mesh_kernel = ctx.kernel.on_mesh();
+    let mesh_kernel = ctx.mesh_kernel;
     for (i, (kind, target)) in ctx.setup.boundaries.iter().enumerate() {
         let wall_kind = match kind {
             BoundaryKind::Fixed => WallKind::Fixed,
@@ -37,7 +38,7 @@ pub(crate) fn apply_boundaries<const D: usize>(
                 if nodes.is_empty() {
                     return Err(scene.value_error(
                         format!("boundaries[{i}].plane"),
-                        format!("no {} node lies on or beyond the plane", ctx.kernel.name()),
+                        format!("no {} node lies on or beyond the plane", ctx.kernel_name),
                     ));
                 }
                 sim.boundary().reaction_sets.push(nodes);
@@ -71,7 +72,7 @@ pub(crate) fn apply_boundaries<const D: usize>(
                         format!("boundaries[{i}].group"),
                         format!(
                             "no {} node lies outside the mesh near the group",
-                            ctx.kernel.name()
+                            ctx.kernel_name
                         ),
                     ));
                 }
@@ -116,7 +117,7 @@ pub(crate) fn apply_boundaries<const D: usize>(
                 if nodes.is_empty() {
                     return Err(scene.value_error(
                         format!("boundaries[{i}].region"),
-                        format!("holds no {} node", ctx.kernel.name()),
+                        format!("holds no {} node", ctx.kernel_name),
                     ));
                 }
                 match normal {

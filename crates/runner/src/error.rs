@@ -6,7 +6,7 @@ use thiserror::Error;
 
 /// Why a command failed.
 #[derive(Debug, Error)]
-pub enum CliError {
+pub enum RunError {
     /// The scene file is not valid TOML or does not match the schema (unknown key, wrong
     /// type); the message from the TOML reader names the key and line.
     #[error("{file}: {message}")]
@@ -78,4 +78,4 @@ pub enum CliError {
 }
 
 /// Shorthand.
-pub type Result<T> = std::result::Result<T, CliError>;
+pub type Result<T> = std::result::Result<T, RunError>;

@@ -4,19 +4,18 @@
 
 use std::path::Path;
 
-use umls_cli::run::RunOptions;
-use umls_cli::scene::Scene;
-use umls_cli::schema::KernelKind;
+use umls_runner::run::RunOptions;
+use umls_runner::scene::Scene;
+use umls_runner::schema::KernelKind;
 
 /// Two threads, no progress bar, output under the test target's scratch directory.
 pub fn options(name: &str, kernel: Option<KernelKind>, end_time: Option<f64>) -> RunOptions {
     RunOptions {
         kernel,
-        out: std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name),
+        out: Some(std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name)),
         end_time,
         threads: Some(2),
-        progress: false,
-        interrupt: None,
+        ..RunOptions::default()
     }
 }
 
@@ -30,9 +29,14 @@ pub fn metric(summary: &serde_json::Value, name: &str) -> f64 {
 /// The metric `key` of `scene` run with `kernel` (output under `name`); the run must
 /// complete.
 pub fn completed_metric(scene: &Scene, name: &str, kernel: KernelKind, key: &str) -> f64 {
-    let report = umls_cli::run::run(scene, &options(name, Some(kernel), None)).unwrap();
-    assert_eq!(report.summary["status"], "completed", "{}", report.summary);
-    metric(&report.summary, key)
+    let report = umls_runner::run::run(scene, &options(name, Some(kernel), None)).unwrap();
+    assert_eq!(
+        report.summary.to_json()["status"],
+        "completed",
+        "{}",
+        report.summary.to_json()
+    );
+    metric(&report.summary.to_json(), key)
 }
 
 /// The built-in scene with each `find` replaced by its `replace` (which must occur).
@@ -42,7 +46,7 @@ pub fn variant(name: &str, edits: &[(&str, &str)]) -> Scene {
 
 /// The text of [`variant`], for edits the parser is meant to refuse.
 pub fn variant_text(name: &str, edits: &[(&str, &str)]) -> String {
-    let mut text = umls_cli::builtin::BUILTIN
+    let mut text = umls_runner::builtin::BUILTIN
         .iter()
         .find(|b| b.name == name)
         .unwrap()

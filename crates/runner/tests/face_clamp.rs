@@ -5,10 +5,10 @@
 //! Kuhn tetrahedra swings alike wherever the lattice lies under it, and converges to its
 //! reference history under refinement.
 
-use umls_cli::edit::refine;
-use umls_cli::run::run;
-use umls_cli::scene::Scene;
-use umls_cli::schema::KernelKind;
+use umls_runner::edit::refine;
+use umls_runner::run::run;
+use umls_runner::scene::Scene;
+use umls_runner::schema::KernelKind;
 
 #[path = "common/runs.rs"]
 mod runs;
@@ -49,7 +49,7 @@ fn tip_history(scene: &str, angle: f64, imposed: &str) -> Vec<[f64; 3]> {
     let name = format!("face-clamp-{scene}-{angle}-{imposed}");
     let out = options(&name, Some(KernelKind::Umls), Some(1.0));
     run(&edited, &out).unwrap();
-    let history = History::read(&out.out);
+    let history = History::read(out.out.as_deref().unwrap());
     let (t, ux, uy) = (
         history.column("time"),
         history.column("probe0_ux"),
@@ -116,7 +116,7 @@ fn deepest_3d_tip(shift: f64, imposed: &str) -> f64 {
     let scene = Scene::load_with("cantilever-3d", &edits).unwrap();
     let out = options(&format!("face-clamp-3d-{shift}-{imposed}"), None, None);
     run(&scene, &out).unwrap();
-    let history = History::read(&out.out);
+    let history = History::read(out.out.as_deref().unwrap());
     let uy = history.column("probe0_uy");
     history.rows.iter().map(|r| r[uy]).fold(0.0, f64::min)
 }
@@ -146,8 +146,13 @@ fn error_against_3d_reference(k: f64) -> f64 {
     refine(&mut scene, k).unwrap();
     let out = options(&format!("cantilever-3d-refined-{k}"), None, None);
     let report = run(&scene, &out).unwrap();
-    assert_eq!(report.summary["status"], "completed", "{}", report.summary);
-    metric(&report.summary, "probe_error_max")
+    assert_eq!(
+        report.summary.to_json()["status"],
+        "completed",
+        "{}",
+        report.summary.to_json()
+    );
+    metric(&report.summary.to_json(), "probe_error_max")
 }
 
 /// Held on its face, the 3D beam's probe converges to the reference history: `umls`

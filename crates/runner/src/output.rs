@@ -11,27 +11,31 @@ use umls_io::vtk::{Collection, Encoding, UnstructuredGrid, pad_vector};
 use umls_mesh::SimplexMesh;
 use umls_transfer::Kernel;
 
-use crate::error::{CliError, Result};
+use crate::error::{Result, RunError};
 use umls_constitutive::table::{MaterialTable, PlasticPart};
 
-/// The output directory of a run.
+/// The output directory of a run; a run without one counts its frames and writes
+/// nothing.
 #[derive(Debug)]
 pub struct OutputDir {
-    dir: PathBuf,
+    dir: Option<PathBuf>,
     encoding: Encoding,
     collection: Collection,
 }
 
 impl OutputDir {
-    /// Creates `dir` (and its parents).
-    pub fn create(dir: &Path, encoding: Encoding) -> Result<Self> {
-        std::fs::create_dir_all(dir).map_err(|source| CliError::File {
-            path: dir.to_path_buf(),
-            source,
-        })?;
-        clear_previous_run(dir)?;
+    /// Creates `dir` (and its parents) and removes an earlier run's files from it;
+    /// `None` for a run that writes no files.
+    pub fn create(dir: Option<&Path>, encoding: Encoding) -> Result<Self> {
+        if let Some(dir) = dir {
+            std::fs::create_dir_all(dir).map_err(|source| RunError::File {
+                path: dir.to_path_buf(),
+                source,
+            })?;
+            clear_previous_run(dir)?;
+        }
         Ok(Self {
-            dir: dir.to_path_buf(),
+            dir: dir.map(Path::to_path_buf),
             encoding,
             collection: Collection::default(),
         })
@@ -48,9 +52,9 @@ impl OutputDir {
         "particles_*.vtu",
     ];
 
-    /// A path inside the directory.
-    pub fn path(&self, name: &str) -> PathBuf {
-        self.dir.join(name)
+    /// A path inside the directory (`None` for a run that writes no files).
+    pub fn path(&self, name: &str) -> Option<PathBuf> {
+        self.dir.as_ref().map(|dir| dir.join(name))
     }
 
     /// Frames written so far.
@@ -70,6 +74,10 @@ impl OutputDir {
         P: PlasticPart<D>,
         T: TransferScheme,
     {
+        let Some(dir) = self.dir.clone() else {
+            self.collection.push(sim.time(), String::new());
+            return Ok(());
+        };
         let p = &sim.particles();
         let mut grid = UnstructuredGrid::point_cloud(p.position.iter().map(pad_vector).collect());
         grid.add_point_vectors("velocity", &p.velocity)?;
@@ -152,9 +160,9 @@ impl OutputDir {
             }
         }
         let name = format!("particles_{:05}.vtu", self.frames());
-        grid.write_vtu(self.path(&name), self.encoding)?;
+        grid.write_vtu(dir.join(&name), self.encoding)?;
         self.collection.push(sim.time(), name);
-        self.collection.write(self.path("particles.pvd"))?;
+        self.collection.write(dir.join("particles.pvd"))?;
         Ok(())
     }
 
@@ -166,6 +174,9 @@ impl OutputDir {
         groups: &[PhysicalGroup],
         grid_fields: Option<(&[f64], &[SVector<f64, D>])>,
     ) -> Result<()> {
+        let Some(path) = self.path("mesh.vtu") else {
+            return Ok(());
+        };
         let mut grid = UnstructuredGrid::from_mesh(mesh);
         if let Some((mass, velocity)) = grid_fields {
             grid.add_point_field("node_mass", 1, mass.to_vec())?;
@@ -192,7 +203,7 @@ impl OutputDir {
                 grid.add_cell_ids(&format!("group {}", g.name), cells)?;
             }
         }
-        grid.write_vtu(self.path("mesh.vtu"), self.encoding)?;
+        grid.write_vtu(path, self.encoding)?;
         Ok(())
     }
 
@@ -204,10 +215,13 @@ impl OutputDir {
         mass: &[f64],
         velocity: &[SVector<f64, D>],
     ) -> Result<()> {
+        let Some(path) = self.path("grid.vtu") else {
+            return Ok(());
+        };
         let mut grid = UnstructuredGrid::point_cloud(nodes.iter().map(pad_vector).collect());
         grid.add_point_field("node_mass", 1, mass.to_vec())?;
         grid.add_point_vectors("node_velocity", velocity)?;
-        grid.write_vtu(self.path("grid.vtu"), self.encoding)?;
+        grid.write_vtu(path, self.encoding)?;
         Ok(())
     }
 }
@@ -217,7 +231,7 @@ impl OutputDir {
 /// stale frames that ParaView loads as one series, and a B-spline run's `grid.vtu` would
 /// outlive it.
 fn clear_previous_run(dir: &Path) -> Result<()> {
-    let entries = std::fs::read_dir(dir).map_err(|source| CliError::File {
+    let entries = std::fs::read_dir(dir).map_err(|source| RunError::File {
         path: dir.to_path_buf(),
         source,
     })?;
@@ -231,7 +245,7 @@ fn clear_previous_run(dir: &Path) -> Result<()> {
             || frame.is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()));
         if owned && entry.file_type().is_ok_and(|t| t.is_file()) {
             let path = entry.path();
-            std::fs::remove_file(&path).map_err(|source| CliError::File { path, source })?;
+            std::fs::remove_file(&path).map_err(|source| RunError::File { path, source })?;
         }
     }
     Ok(())

@@ -2,8 +2,8 @@
 //! support radii it implies, move the energy each kernel loses (docs/umls-kernel.md,
 //! *Mesh layout*).
 
-use umls_cli::run::run;
-use umls_cli::schema::KernelKind;
+use umls_runner::run::run;
+use umls_runner::schema::KernelKind;
 
 #[path = "common/runs.rs"]
 mod runs;
@@ -29,11 +29,12 @@ fn refined_lost(
     let mut all = vec![("kind = \"flip\"", kind_edit.as_str())];
     all.extend_from_slice(edits);
     let mut scene = variant("colliding-disks", &all);
-    umls_cli::edit::refine(&mut scene, refine).unwrap();
+    umls_runner::edit::refine(&mut scene, refine).unwrap();
     let name = format!("disks-layout-{tag}-{refine}-{}-{kind}", kernel.name());
     let summary = run(&scene, &options(&name, Some(kernel), None))
         .unwrap()
-        .summary;
+        .summary
+        .to_json();
     assert_eq!(summary["status"], "completed", "{summary}");
     -metric(&summary, "energy_change_final")
 }

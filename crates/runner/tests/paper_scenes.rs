@@ -2,10 +2,10 @@
 //! combined regions; a mesh turned under its particles, a clamp of nodes in a region,
 //! probes and a stored reference history.
 
-use umls_cli::run::run;
-use umls_cli::scene::Scene;
-use umls_cli::schema::KernelKind;
-use umls_cli::setup::{build, triangles};
+use umls_runner::run::run;
+use umls_runner::scene::Scene;
+use umls_runner::schema::KernelKind;
+use umls_runner::setup::{build, triangles};
 
 #[path = "common/runs.rs"]
 mod runs;
@@ -31,7 +31,7 @@ fn vortex_seeds_the_annulus() {
 #[test]
 fn the_vortex_body_force_is_the_manufactured_solutions() {
     use nalgebra::{Matrix2, Rotation2, Vector2};
-    use umls_cli::schema::ForcePosition;
+    use umls_runner::schema::ForcePosition;
     let setup = build::<2>(&Scene::load("vortex").unwrap(), triangles).unwrap();
     let (field, position) = setup.body_force.as_ref().unwrap();
     assert_eq!(*position, ForcePosition::Reference);
@@ -113,8 +113,13 @@ fn a_reference_body_force_acts_where_each_particle_started() {
         .sum();
     let momentum = |scene: &Scene, name: &str| {
         let report = run(scene, &options(name, Some(KernelKind::Umls), Some(0.2))).unwrap();
-        assert_eq!(report.summary["status"], "completed", "{}", report.summary);
-        let history = History::read(&options(name, None, None).out);
+        assert_eq!(
+            report.summary.to_json()["status"],
+            "completed",
+            "{}",
+            report.summary.to_json()
+        );
+        let history = History::read(options(name, None, None).out.as_deref().unwrap());
         let (t, p) = (history.column("time"), history.column("momentum_x"));
         history
             .rows
@@ -227,8 +232,8 @@ fn vortex_converges_with_umls() {
     )
     .unwrap();
     let (e1, e2) = (
-        metric(&coarse.summary, "displacement_error_max"),
-        metric(&fine.summary, "displacement_error_max"),
+        metric(&coarse.summary.to_json(), "displacement_error_max"),
+        metric(&fine.summary.to_json(), "displacement_error_max"),
     );
     // The largest exact displacement is about A·R = 0.3.
     assert!(e1 < 0.3 && e2 < e1 / 3.0, "{e1} → {e2}");
@@ -285,11 +290,19 @@ fn a_run_that_inverts_a_particle_still_writes_its_summary() {
     let options = options("inverted", Some(KernelKind::LinearFe), None);
     let err = run(&scene, &options).unwrap_err();
     assert!(err.to_string().contains("det F"), "{err}");
-    let text = std::fs::read_to_string(options.out.join("summary.json")).unwrap();
+    let text =
+        std::fs::read_to_string(options.out.as_deref().unwrap().join("summary.json")).unwrap();
     let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(summary["status"], "failed");
     assert!(summary["error"].as_str().unwrap().contains("det F"));
-    assert!(options.out.join("energies.svg").exists());
+    assert!(
+        options
+            .out
+            .as_deref()
+            .unwrap()
+            .join("energies.svg")
+            .exists()
+    );
 }
 
 /// Turning the mesh leaves the particles where they are (the anchored lattice), and the
@@ -332,7 +345,7 @@ fn cantilever_clamp_holds_and_the_tip_follows_the_reference() {
     for kernel in [KernelKind::Bspline2, KernelKind::LinearFe] {
         let out = options(&format!("cantilever-{kernel:?}"), Some(kernel), Some(0.3));
         let report = run(&scene, &out).unwrap();
-        let history = History::read(&out.out);
+        let history = History::read(out.out.as_deref().unwrap());
         let column = |name: &str| history.last(name);
         assert!(
             column("probe0_uy") < -0.1,
@@ -345,9 +358,9 @@ fn cantilever_clamp_holds_and_the_tip_follows_the_reference() {
             "{kernel:?}"
         );
         assert!(
-            metric(&report.summary, "probe_error_max") < 0.05,
+            metric(&report.summary.to_json(), "probe_error_max") < 0.05,
             "{kernel:?}: {}",
-            report.summary["metrics"]
+            report.summary.to_json()["metrics"]
         );
     }
 }
@@ -361,7 +374,7 @@ fn expanding_ball_presses_evenly_on_the_curved_wall() {
     for kernel in [KernelKind::LinearFe, KernelKind::Umls, KernelKind::Bspline2] {
         let out = options(&format!("sphere-{kernel:?}"), Some(kernel), Some(0.05));
         let report = run(&Scene::load("sphere-expansion-3d").unwrap(), &out).unwrap();
-        let s = &report.summary;
+        let s = &report.summary.to_json();
         assert!(
             metric(s, "pressure_max") > 1e3,
             "{kernel:?}: {}",
@@ -385,7 +398,8 @@ fn expanding_ball_presses_evenly_on_the_curved_wall() {
                 s["metrics"]
             );
         }
-        let text = std::fs::read_to_string(out.out.join("history.csv")).unwrap();
+        let text =
+            std::fs::read_to_string(out.out.as_deref().unwrap().join("history.csv")).unwrap();
         assert!(text.lines().next().unwrap().contains("reaction0_magnitude"));
     }
 }
@@ -398,7 +412,7 @@ fn slope_starts_to_slide_with_both_kernels() {
     for kernel in [KernelKind::Umls, KernelKind::Bspline2] {
         let out = options(&format!("slope-{kernel:?}"), Some(kernel), Some(0.1));
         let report = run(&Scene::load("slope-3d").unwrap(), &out).unwrap();
-        let s = &report.summary;
+        let s = &report.summary.to_json();
         let crest = s["metrics"]["probe_displacements"][0][2].as_f64().unwrap();
         assert!(crest < -1e-3, "{kernel:?}: crest {crest}");
         assert!(metric(s, "front_advance") >= 0.0, "{kernel:?}");
@@ -431,16 +445,16 @@ fn unstructured_turned_cantilever_follows_the_reference() {
     );
     let out = options("cantilever-gmsh-30", Some(KernelKind::Umls), Some(0.3));
     let report = run(&scene, &out).unwrap();
-    let history = History::read(&out.out);
+    let history = History::read(out.out.as_deref().unwrap());
     assert!(
         history.last("probe0_uy") < -0.1,
         "{}",
         history.last("probe0_uy")
     );
     assert!(
-        metric(&report.summary, "probe_error_max") < 0.05,
+        metric(&report.summary.to_json(), "probe_error_max") < 0.05,
         "{}",
-        report.summary["metrics"]
+        report.summary.to_json()["metrics"]
     );
 }
 
@@ -473,9 +487,9 @@ fn a_clamp_imposed_on_the_fit_follows_the_reference_more_closely() {
     let error = |scene: &Scene, name: &str| {
         let out = options(name, Some(KernelKind::Umls), Some(1.0));
         let report = run(scene, &out).unwrap();
-        let history = History::read(&out.out);
+        let history = History::read(out.out.as_deref().unwrap());
         let deep = history.last("probe1_ux").hypot(history.last("probe1_uy"));
-        (metric(&report.summary, "probe_error_max"), deep)
+        (metric(&report.summary.to_json(), "probe_error_max"), deep)
     };
     let (on_nodes, _) = error(&nodes, "cantilever-30-nodes");
     let (on_fit, deep) = error(&fitted, "cantilever-30-fit");

@@ -14,7 +14,7 @@ use umls_mesh::generate::{Diagonal, Lattice};
 use umls_mesh::{Orientation, SampleRule, SimplexMesh};
 
 use crate::background::Background;
-use crate::error::{CliError, Result};
+use crate::error::{Result, RunError};
 use crate::expression::{Definitions, VectorField};
 use crate::frame::SceneFrame;
 use crate::hydrostatic::Hydrostatic;
@@ -26,6 +26,7 @@ use crate::schema::{
     QuadratureSpec, RegionSpec, SeedingSpec, SolidSpec, StressUpdateSpec, TransferKind,
     VelocityTimeSpec,
 };
+pub use crate::seeds::Seeds;
 use umls_constitutive::table::{ElasticModel, Model, PlasticModel};
 
 /// Most lattice points a seeding may generate before filtering by region, and most cells
@@ -33,25 +34,6 @@ use umls_constitutive::table::{ElasticModel, Model, PlasticModel};
 /// exhausted memory (2·10⁷ tetrahedra already take several GB). Larger runs use the
 /// library directly.
 pub const MAX_LATTICE_POINTS: f64 = 2e7;
-
-/// Particles as plain arrays, before they meet a kernel and a material type.
-#[derive(Debug, Clone, Default)]
-pub struct Seeds<const D: usize> {
-    /// Positions.
-    pub position: Vec<SVector<f64, D>>,
-    /// Reference volumes.
-    pub volume: Vec<f64>,
-    /// Masses.
-    pub mass: Vec<f64>,
-    /// Initial velocities.
-    pub velocity: Vec<SVector<f64, D>>,
-    /// Initial affine matrices C_p (zero unless a body's `affine` says otherwise).
-    pub affine: Vec<SMatrix<f64, D, D>>,
-    /// Material index.
-    pub material: Vec<u16>,
-    /// The body (index into `[[bodies]]`) that seeded each particle.
-    pub body: Vec<u32>,
-}
 
 /// A boundary condition resolved to geometry.
 #[derive(Debug, Clone)]
@@ -146,27 +128,6 @@ impl<const D: usize> Setup<D> {
     }
 }
 
-/// A D-vector from the file's list at `key`: D finite components.
-pub(crate) fn vector<const D: usize>(
-    scene: &Scene,
-    key: &str,
-    values: &[f64],
-) -> Result<SVector<f64, D>> {
-    if values.len() != D {
-        return Err(scene.value_error(
-            key,
-            format!(
-                "{} components given, the scene is {D}-dimensional",
-                values.len()
-            ),
-        ));
-    }
-    if values.iter().any(|v| !v.is_finite()) {
-        return Err(scene.value_error(key, "components must be finite"));
-    }
-    Ok(SVector::from_fn(|k, _| values[k]))
-}
-
 /// Splits a lattice into simplices (segments, triangles with the given diagonals, or
 /// tetrahedra); the generator's split exists per dimension, so the caller supplies it.
 pub type Split<const D: usize> =
@@ -218,8 +179,8 @@ fn background<const D: usize>(
             Ok((Background::Mesh(Arc::new(read.mesh)), None, read.groups))
         }
         (None, Some(l)) => {
-            let lower: SVector<f64, D> = vector(scene, "mesh.lattice.lower", &l.lower)?;
-            let upper: SVector<f64, D> = vector(scene, "mesh.lattice.upper", &l.upper)?;
+            let lower: SVector<f64, D> = scene.vector("mesh.lattice.lower", &l.lower)?;
+            let upper: SVector<f64, D> = scene.vector("mesh.lattice.upper", &l.upper)?;
             if l.cells.len() != D {
                 return Err(scene.value_error("mesh.lattice.cells", format!("needs {D} counts")));
             }
@@ -400,15 +361,15 @@ pub(crate) fn region<const D: usize>(
             ));
         }
         RegionSpec::Box { lower, upper } => Region::Box {
-            lower: vector(scene, &format!("{key}.box.lower"), lower)?,
-            upper: vector(scene, &format!("{key}.box.upper"), upper)?,
+            lower: scene.vector(&format!("{key}.box.lower"), lower)?,
+            upper: scene.vector(&format!("{key}.box.upper"), upper)?,
         },
         RegionSpec::Ball { centre, radius } => Region::Ball {
-            centre: vector(scene, &format!("{key}.ball.centre"), centre)?,
+            centre: scene.vector(&format!("{key}.ball.centre"), centre)?,
             radius: *radius,
         },
         RegionSpec::HalfSpace { normal, offset } => Region::HalfSpace {
-            normal: vector(scene, &format!("{key}.half-space.normal"), normal)?,
+            normal: scene.vector(&format!("{key}.half-space.normal"), normal)?,
             offset: *offset,
         },
         RegionSpec::Group(_) => {
@@ -505,7 +466,7 @@ fn seed_body<const D: usize>(
                 );
             }
             let origin: SVector<f64, D> =
-                vector(scene, &key("seeding.lattice-from.origin"), origin)?;
+                scene.vector(&key("seeding.lattice-from.origin"), origin)?;
             let (lower, upper) = background.bounding_box();
             // Whole cells of the anchored lattice that meet the background's box.
             let first = SVector::<f64, D>::from_fn(|k, _| ((lower[k] - origin[k]) / h).floor());
@@ -795,7 +756,7 @@ pub fn build_for<const D: usize>(
                     (None, BoundaryKind::Fixed) => None,
                     (Some(n), BoundaryKind::Slip) => {
                         let n: SVector<f64, D> =
-                            vector(scene, &format!("boundaries[{i}].normal"), n)?;
+                            scene.vector(&format!("boundaries[{i}].normal"), n)?;
                         if n.norm() == 0.0 {
                             return Err(scene.value_error(
                                 format!("boundaries[{i}].normal"),
@@ -845,17 +806,14 @@ pub fn build_for<const D: usize>(
                 }
             }
             (Some(plane), None, None) => {
-                let normal: SVector<f64, D> = vector(
-                    scene,
-                    &format!("boundaries[{i}].plane.normal"),
-                    &plane.normal,
-                )?;
+                let normal: SVector<f64, D> =
+                    scene.vector(&format!("boundaries[{i}].plane.normal"), &plane.normal)?;
                 if normal.norm() == 0.0 {
                     return Err(scene
                         .value_error(format!("boundaries[{i}].plane.normal"), "must not be zero"));
                 }
                 BoundaryTarget::Plane {
-                    point: vector(scene, &format!("boundaries[{i}].plane.point"), &plane.point)?,
+                    point: scene.vector(&format!("boundaries[{i}].plane.point"), &plane.point)?,
                     normal: normal.normalize(),
                 }
             }
@@ -885,7 +843,7 @@ pub fn build_for<const D: usize>(
     }
     let gravity: SVector<f64, D> = match &spec.scene.gravity {
         None => SVector::zeros(),
-        Some(g) => vector(scene, "scene.gravity", g)?,
+        Some(g) => scene.vector("scene.gravity", g)?,
     };
     let stress_update = match spec.time.stress_update {
         StressUpdateSpec::Usl => StressUpdate::Usl,
@@ -1067,7 +1025,7 @@ pub fn build_for<const D: usize>(
             if !(p.area.is_finite() && p.area > 0.0) {
                 return Err(scene.value_error("reference.pressure.area", "must be positive"));
             }
-            let centre: SVector<f64, D> = vector(scene, "reference.pressure.centre", &p.centre)?;
+            let centre: SVector<f64, D> = scene.vector("reference.pressure.centre", &p.centre)?;
             Some((p.boundary, frame.point_to_world(&centre), p.area))
         }
     };
@@ -1206,7 +1164,7 @@ pub fn frame_count(scene: &Scene, end_time: f64) -> usize {
 }
 
 /// The error for a scene that is plastic in 1D.
-pub fn plastic_in_1d(scene: &Scene) -> CliError {
+pub fn plastic_in_1d(scene: &Scene) -> RunError {
     scene.value_error(
         "materials",
         "plastic models need dimension 2 (plane strain) or 3",

@@ -5,10 +5,10 @@
 //! 1000 so that the cases stay fast.)
 
 use proptest::prelude::*;
-use umls_cli::builtin::BUILTIN;
-use umls_cli::scene::Scene;
-use umls_cli::schema::KernelKind;
-use umls_cli::setup::{build_for, segments, tetrahedra, triangles};
+use umls_runner::builtin::BUILTIN;
+use umls_runner::scene::Scene;
+use umls_runner::schema::KernelKind;
+use umls_runner::setup::{build_for, segments, tetrahedra, triangles};
 
 /// Whether `umls run` would build this scene for a grid kernel (no simplices for a
 /// lattice): the fuzz builds what a run builds.

@@ -1,0 +1,115 @@
+//! The material table and the transfer scheme of a run: the last two types of its
+//! simulation, chosen from the scene, and the simulation built from the set-up's seeds.
+
+use std::sync::Arc;
+
+use nalgebra::SVector;
+use umls_constitutive::table::{MaterialTable, PlasticPart, TableState};
+use umls_engine::{
+    AffineTransfer, ApicFlip, Flip, MlsMpm, Particles, QuadraticApicFlip, Simulation, StepSettings,
+    TransferScheme,
+};
+use umls_transfer::Kernel;
+
+use crate::context::{Context, RunReport};
+use crate::error::Result;
+use crate::schema::{ForcePosition, TransferKind};
+
+pub(crate) fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
+    ctx: &Context<'_, D>,
+    kernel: K,
+    table: MaterialTable<P>,
+) -> Result<RunReport> {
+    // Five transfer types for the eight kinds keep down the simulations this crate
+    // compiles: PIC is FLIP with α = 0 (v = 0·(v + Δv) + 1·v_PIC, the same numbers), the
+    // two affine schemes share one type, and quadratic APIC is its FLIP blend at α = 0
+    // (the same bits, tested in the engine). APIC-FLIP has its own type, so that APIC
+    // does not read the old grid velocities it has no use for; MLS-MPM has its own, as
+    // its force is folded into the momentum.
+    let t = &ctx.scene.spec.transfer;
+    if !(0.0..=1.0).contains(&t.alpha) {
+        return Err(ctx
+            .scene
+            .value_error("transfer.alpha", format!("{} is not in [0, 1]", t.alpha)));
+    }
+    match t.kind {
+        TransferKind::Pic => start(ctx, kernel, table, Flip { alpha: 0.0 }),
+        TransferKind::Flip => start(ctx, kernel, table, Flip { alpha: t.alpha }),
+        TransferKind::ApicFlip => start(ctx, kernel, table, ApicFlip { alpha: t.alpha }),
+        TransferKind::Apic => start(ctx, kernel, table, AffineTransfer::Apic),
+        TransferKind::QuadraticApic => start(ctx, kernel, table, QuadraticApicFlip { alpha: 0.0 }),
+        TransferKind::QuadraticApicFlip => {
+            start(ctx, kernel, table, QuadraticApicFlip { alpha: t.alpha })
+        }
+        TransferKind::VelocityGradient => {
+            start(ctx, kernel, table, AffineTransfer::VelocityGradient)
+        }
+        TransferKind::MlsMpm => {
+            if !kernel.regular_second_moment() {
+                return Err(ctx.scene.value_error(
+                    "transfer.kind",
+                    "mls-mpm takes D_p⁻¹ N_i (x_i − x_p) as the force's gradient, and linear \
+                     elements' D_p vanishes at the vertices: it needs a B-spline or UMLS kernel",
+                ));
+            }
+            start(ctx, kernel, table, MlsMpm)
+        }
+    }
+}
+
+/// The typed part of a run: particles of the table's state and the kernel's cache, and
+/// the simulation, handed to the run loop as a [`Run`].
+fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
+    ctx: &Context<'_, D>,
+    kernel: K,
+    table: MaterialTable<P>,
+    transfer: T,
+) -> Result<RunReport> {
+    let seeds = &ctx.setup.seeds;
+    let mut particles = Particles::<D, TableState<P::State>, K::Cache>::at_rest(
+        seeds.position.clone(),
+        seeds.volume.clone(),
+        1.0,
+        TableState::default(),
+    );
+    particles.mass.clone_from(&seeds.mass);
+    particles.velocity.clone_from(&seeds.velocity);
+    particles.affine.clone_from(&seeds.affine);
+    for (state, &m) in particles.state.iter_mut().zip(&seeds.material) {
+        state.material = m;
+    }
+    let mut settings = StepSettings::new(1.0);
+    settings.gravity = ctx.setup.gravity;
+    settings.gravity_ramp = ctx.setup.gravity_ramp;
+    settings.stress_update = ctx.setup.stress_update;
+    settings.stencil_storage = ctx.scene.spec.kernel.stencils.storage();
+    settings.particle_sort_interval = ctx.scene.spec.kernel.particle_sort_interval;
+    settings.mass_matrix = crate::schema::MassSpec::matrix(ctx.scene.spec.transfer.mass);
+    settings.damping = ctx.setup.damping;
+    let mut sim = Simulation::new(kernel, table, transfer, particles, settings)?;
+    if let Some((field, position)) = &ctx.setup.body_force {
+        let (field, frame) = (field.clone(), ctx.setup.frame);
+        // The seeds are where the particles start, in the particles' order.
+        let reference: Option<Vec<SVector<f64, D>>> =
+            (*position == ForcePosition::Reference).then(|| {
+                seeds
+                    .position
+                    .iter()
+                    .map(|x| frame.point_to_scene(x))
+                    .collect()
+            });
+        // An evaluation error (none is expected: the field was evaluated at every
+        // particle before the run) gives NaN, which the engine stops at.
+        sim.body_force = Some(Arc::new(move |p: usize, x: &SVector<f64, D>, t: f64| {
+            let at = match &reference {
+                Some(start) => start[p],
+                None => frame.point_to_scene(x),
+            };
+            field
+                .eval(&at, t)
+                .map(|b| frame.vector_to_world(&b))
+                .unwrap_or_else(|_| SVector::from_element(f64::NAN))
+        }));
+    }
+    crate::drive::drive(ctx, &mut sim)
+}
