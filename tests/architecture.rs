@@ -46,8 +46,8 @@ fn ring(name: &str) -> Option<usize> {
     RINGS.iter().position(|r| r.contains(&name))
 }
 
-#[test]
-fn dependencies_point_inward() {
+/// The workspace's packages, from `cargo metadata`.
+fn metadata() -> serde_json::Value {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let output = Command::new(cargo)
         .args([
@@ -65,7 +65,12 @@ fn dependencies_point_inward() {
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
-    let metadata: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    serde_json::from_slice(&output.stdout).unwrap()
+}
+
+#[test]
+fn dependencies_point_inward() {
+    let metadata = metadata();
     let mut checked = 0;
     for package in metadata["packages"].as_array().unwrap() {
         let name = package["name"].as_str().unwrap();
@@ -93,19 +98,7 @@ fn dependencies_point_inward() {
 
 /// The workspace's normal dependencies of `package`, from `cargo metadata`.
 fn normal_dependencies(package: &str) -> Vec<String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let output = Command::new(cargo)
-        .args([
-            "metadata",
-            "--format-version",
-            "1",
-            "--no-deps",
-            "--offline",
-        ])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("cargo metadata runs");
-    let metadata: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let metadata = metadata();
     let packages = metadata["packages"].as_array().unwrap();
     let found = packages
         .iter()

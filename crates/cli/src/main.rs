@@ -25,39 +25,7 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Run a built-in scene or a TOML scene file and write ParaView and CSV output.
-    Run {
-        /// A built-in scene name (see `umls scenes`) or the path of a TOML scene file.
-        scene: String,
-        /// Shape-function kernel (default: the scene's).
-        #[arg(long, value_parser = kernel_names())]
-        kernel: Option<String>,
-        /// Output directory (default: out/SCENE-KERNEL, with a short tag of the edits
-        /// when `--set`, `--refine` or `--particle-refine` change the scene); the files
-        /// of an earlier run there are replaced.
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Simulated time (default: the scene's).
-        #[arg(long)]
-        end_time: Option<f64>,
-        /// Worker threads (default: all cores).
-        #[arg(long)]
-        threads: Option<usize>,
-        /// Do not draw the progress bar.
-        #[arg(long)]
-        quiet: bool,
-        /// Replace a value of the scene before it is read, e.g. `--set time.cfl=0.5`,
-        /// `--set mesh.lattice.jitter=0.3`, `--set bodies.0.seeding.lattice=0.025`
-        /// (repeatable; the value is TOML, or else a string).
-        #[arg(long = "set", value_name = "KEY=VALUE", value_parser = umls_runner::edit::parse_assignment)]
-        set: Vec<(String, String)>,
-        /// Divide every length of the discretisation by this factor: lattice cells,
-        /// particle spacing, B-spline grid spacing and a fixed time step.
-        #[arg(long, value_name = "FACTOR")]
-        refine: Option<f64>,
-        /// Divide the particle spacing alone by this factor (particles per cell × FACTOR^D).
-        #[arg(long, value_name = "FACTOR")]
-        particle_refine: Option<f64>,
-    },
+    Run(RunArgs),
     /// Run a study matrix (scenes × kernels × resolutions, stability sweeps, throughput)
     /// and write a report with charts: report.md, charts/*.svg, results.csv/json.
     Report {
@@ -118,27 +86,7 @@ fn main() -> ExitCode {
         Command::MeshInfo { file } => mesh_info::mesh_info(&file)
             .map(|r| print!("{r}"))
             .map_err(Failure::from),
-        Command::Run {
-            scene,
-            kernel,
-            out,
-            end_time,
-            threads,
-            quiet,
-            set,
-            refine,
-            particle_refine,
-        } => run_scene(RunArgs {
-            scene,
-            kernel: kernel.as_deref().and_then(KernelKind::from_name),
-            out,
-            end_time,
-            threads,
-            quiet,
-            set,
-            refine,
-            particle_refine,
-        }),
+        Command::Run(args) => run_scene(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -159,15 +107,38 @@ fn kernel_names() -> clap::builder::PossibleValuesParser {
 }
 
 /// `umls run`'s arguments.
+#[derive(Debug, clap::Args)]
 struct RunArgs {
+    /// A built-in scene name (see `umls scenes`) or the path of a TOML scene file.
     scene: String,
-    kernel: Option<KernelKind>,
+    /// Shape-function kernel (default: the scene's).
+    #[arg(long, value_parser = kernel_names())]
+    kernel: Option<String>,
+    /// Output directory (default: out/SCENE-KERNEL, with a short tag of the edits
+    /// when `--set`, `--refine` or `--particle-refine` change the scene); the files
+    /// of an earlier run there are replaced.
+    #[arg(long)]
     out: Option<PathBuf>,
+    /// Simulated time (default: the scene's).
+    #[arg(long)]
     end_time: Option<f64>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
     threads: Option<usize>,
+    /// Do not draw the progress bar.
+    #[arg(long)]
     quiet: bool,
+    /// Replace a value of the scene before it is read, e.g. `--set time.cfl=0.5`,
+    /// `--set mesh.lattice.jitter=0.3`, `--set bodies.0.seeding.lattice=0.025`
+    /// (repeatable; the value is TOML, or else a string).
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = umls_runner::edit::parse_assignment)]
     set: Vec<(String, String)>,
+    /// Divide every length of the discretisation by this factor: lattice cells,
+    /// particle spacing, B-spline grid spacing and a fixed time step.
+    #[arg(long, value_name = "FACTOR")]
     refine: Option<f64>,
+    /// Divide the particle spacing alone by this factor (particles per cell × FACTOR^D).
+    #[arg(long, value_name = "FACTOR")]
     particle_refine: Option<f64>,
 }
 
@@ -180,13 +151,15 @@ fn run_scene(args: RunArgs) -> Result<(), Failure> {
     if let Some(factor) = args.particle_refine {
         umls_runner::edit::refine_particles(&mut scene, factor)?;
     }
-    let kernel_name = args.kernel.unwrap_or(scene.spec.kernel.kind).name();
+    // clap accepts only the presets' names, so the lookup finds one.
+    let kernel = args.kernel.as_deref().and_then(KernelKind::from_name);
+    let kernel_name = kernel.unwrap_or(scene.spec.kernel.kind).name();
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| default_out(&scene.spec.scene.name, kernel_name, &args));
     let options = RunOptions {
-        kernel: args.kernel,
+        kernel,
         out: Some(out),
         end_time: args.end_time,
         threads: args.threads,

@@ -53,7 +53,7 @@ pub(crate) fn drive<const D: usize>(
     };
     let history = recorder.finish()?;
     write_background(ctx, sim, &out)?;
-    recorder.energy_plot(ctx, &out)?;
+    recorder.energy_plot(&out)?;
     let outcome = Outcome {
         plan: &plan,
         warnings,
@@ -62,7 +62,7 @@ pub(crate) fn drive<const D: usize>(
         frames: out.frames(),
         max_wave_courant: recorder.max_wave_courant(),
     };
-    let metrics = recorder.metrics(ctx, sim, failure.is_some())?;
+    let metrics = recorder.metrics(sim, failure.is_some())?;
     let summary = summarise(ctx, sim, &outcome, metrics);
     if let Some(path) = out.path("summary.json") {
         summary.write(&path)?;

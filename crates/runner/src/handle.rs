@@ -13,7 +13,7 @@ use umls_transfer::Kernel;
 use crate::error::Result;
 use crate::output::OutputDir;
 
-/// What the run loop needs of a simulation. Object-safe, so [`drive`] is compiled once
+/// What the run loop needs of a simulation. Object-safe, so [`crate::drive::drive`] is compiled once
 /// per dimension; only [`Run::step`] and the output of particle fields are compiled for
 /// each kernel, material table and transfer, which is where the time goes.
 pub(crate) trait Run<const D: usize> {

@@ -3,7 +3,7 @@
 //! the built-in presets behind the scene key `[kernel] kind` and `umls run --kernel`.
 //!
 //! A preset names a kernel type and its settings: the UMLS variants differ in profile,
-//! support radius, gradient, exponent of η and integration correction ([`umls_preset`]);
+//! support radius, gradient, exponent of η and integration correction (`umls_preset`);
 //! `linear-fe` and the B-spline grids have one setting each. A kernel from outside the
 //! workspace implements [`KernelFactory`] and goes through the same run loop
 //! ([`crate::run_with`]), with the same outputs, metrics and summary.

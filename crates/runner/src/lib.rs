@@ -6,7 +6,7 @@
 //!
 //! - [`Scene`] loads a built-in scene or a scene file ([`schema`]), with `--set`-style
 //!   edits and refinement ([`edit`]).
-//! - [`run`] runs it with the scene's kernel or a built-in preset
+//! - [`run()`] runs it with the scene's kernel or a built-in preset
 //!   ([`schema::KernelKind`]); [`run_with`] runs it with any kernel type through the
 //!   [`KernelFactory`] port, with the same outputs and metrics.
 //! - [`RunOptions::out`] chooses whether files are written (ParaView frames

@@ -207,16 +207,17 @@ impl<'a, const D: usize> Recorder<'a, D> {
         Ok(())
     }
 
-    /// Flushes `history.csv`; the history recorded.
+    /// Flushes `history.csv`; the history recorded (the recorder keeps no copy).
     pub(crate) fn finish(&mut self) -> Result<History> {
         if let Some(file) = self.file.as_mut() {
             file.flush()?;
         }
-        Ok(self.history.clone())
+        Ok(std::mem::take(&mut self.history))
     }
 
     /// `energies.svg`.
-    pub(crate) fn energy_plot(&self, ctx: &Context<'_, D>, out: &OutputDir) -> Result<()> {
+    pub(crate) fn energy_plot(&self, out: &OutputDir) -> Result<()> {
+        let ctx = self.ctx;
         let Some(path) = out.path("energies.svg") else {
             return Ok(());
         };
@@ -234,20 +235,15 @@ impl<'a, const D: usize> Recorder<'a, D> {
         )
     }
 
-    /// The initial and the last recorded diagnostics and total energies, and the largest
-    /// wave Courant number of the rows.
+    /// The largest wave Courant number of the rows.
     pub(crate) fn max_wave_courant(&self) -> f64 {
         self.energy.max_wave_courant
     }
 
     /// The end metrics: energy and momentum, the reference errors, and the scene's own
     /// (end state, wall pressure, probes).
-    pub(crate) fn metrics(
-        &self,
-        ctx: &Context<'_, D>,
-        sim: &dyn Run<D>,
-        failed: bool,
-    ) -> Result<Map<String, Value>> {
+    pub(crate) fn metrics(&self, sim: &dyn Run<D>, failed: bool) -> Result<Map<String, Value>> {
+        let ctx = self.ctx;
         let mut metrics = self.energy.metrics();
         let taken = sim.step_count();
         if ctx.setup.reference.is_some() && taken > 0 {

@@ -1,11 +1,11 @@
 //! Running a scene: build its set-up for its dimension, build the kernel (a built-in
 //! preset or a [`KernelFactory`] of the caller's), pick the material table and transfer
-//! types, and hand the typed simulation to the run loop ([`crate::drive`]).
+//! types, and hand the typed simulation to the run loop (the private `drive` module).
 //!
 //! Each (dimension, kernel, transfer, plasticity) combination is its own monomorphized
 //! simulation, so a run steps with exactly the code its scene needs. The run loop around
 //! it (time step, boundaries, output, history, summary) sees the simulation through the
-//! object-safe [`crate::handle::Run`] trait and is compiled once per dimension.
+//! object-safe `Run` trait and is compiled once per dimension.
 
 use umls_constitutive::table::{MaterialTable, Model, NoPlasticity, PlasticModel, PlasticPart};
 use umls_io::vtk::Encoding;
@@ -58,9 +58,7 @@ impl SceneDimension<2> for Dim<2> {
     type Plastic = PlasticModel;
     const SPLIT: Split<2> = setup::triangles;
     fn plastic_table(models: &[Model<PlasticModel>]) -> Option<MaterialTable<PlasticModel>> {
-        Some(MaterialTable {
-            models: models.to_vec(),
-        })
+        plastic_table(models)
     }
 }
 
@@ -70,10 +68,15 @@ impl SceneDimension<3> for Dim<3> {
     type Plastic = PlasticModel;
     const SPLIT: Split<3> = setup::tetrahedra;
     fn plastic_table(models: &[Model<PlasticModel>]) -> Option<MaterialTable<PlasticModel>> {
-        Some(MaterialTable {
-            models: models.to_vec(),
-        })
+        plastic_table(models)
     }
+}
+
+/// The table of the scene's models, plastic ones included (D = 2, 3).
+fn plastic_table(models: &[Model<PlasticModel>]) -> Option<MaterialTable<PlasticModel>> {
+    Some(MaterialTable {
+        models: models.to_vec(),
+    })
 }
 
 /// Runs `scene` with `options`, with the scene's kernel or `options.kernel`.

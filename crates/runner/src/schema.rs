@@ -358,32 +358,6 @@ impl StencilsSpec {
     }
 }
 
-impl KernelKind {
-    /// Whether the kernel's nodes are the mesh vertices (UMLS or linear FE).
-    pub fn on_mesh(self) -> bool {
-        self.is_umls() || self == KernelKind::LinearFe
-    }
-
-    /// Whether the kernel is one of the UMLS variants.
-    pub fn is_umls(self) -> bool {
-        matches!(
-            self,
-            KernelKind::Umls
-                | KernelKind::UmlsQuadratic
-                | KernelKind::UmlsWendland
-                | KernelKind::UmlsSharp
-                | KernelKind::UmlsWide
-                | KernelKind::UmlsPaper
-                | KernelKind::UmlsFullGradient
-                | KernelKind::UmlsFrozenEta
-                | KernelKind::UmlsUncorrected
-                | KernelKind::UmlsEta4
-                | KernelKind::UmlsEta8
-                | KernelKind::UmlsElementSize
-        )
-    }
-}
-
 /// `kernel.weight`: the UMLS distance-weight profile.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "kebab-case")]
