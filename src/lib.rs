@@ -14,6 +14,8 @@
 //! - [`transfer`] (`umls-transfer`), [`kernels`] (`umls-kernels`), [`engine`]
 //!   (`umls-engine`): the kernel port, the UMLS / linear-FE / B-spline kernels, and the
 //!   explicit MPM engine;
+//! - [`ugimp`] (`umls-ugimp`): the uGIMP kernel on a grid, a kernel written against the
+//!   port alone;
 //! - [`runner`] (`umls-runner`): scenes as a library: the scene format, the built-in
 //!   scenes and the runner that steps any kernel through them ([`runner::run_with`]);
 //! - [`scenes`] (`umls-scenes`): the benchmark scenes with their references;
@@ -43,3 +45,4 @@ pub use umls_mls as mls;
 pub use umls_runner as runner;
 pub use umls_scenes as scenes;
 pub use umls_transfer as transfer;
+pub use umls_ugimp as ugimp;

@@ -370,65 +370,13 @@ impl<const D: usize> BSplineKernel<D> {
         &self,
         order: BSplineOrder,
         x: &SVector<f64, D>,
-        mut visit: F,
+        visit: F,
     ) -> Result<(), KernelError>
     where
         F: FnMut(u32, f64, &SVector<f64, D>, &SVector<f64, D>),
     {
-        let TensorStencil {
-            first,
-            strides,
-            values: w,
-            derivatives: dw,
-            offsets: r,
-            ..
-        } = self.tensor_of_width::<W>(order, x)?;
-        // The factors are multiplied in axis order, as N = Π_k w_k reads (regrouping
-        // them would change the last bit of the results).
-        let mut digits = [0usize; D];
-        loop {
-            let mut node = first;
-            for k in 1..D {
-                node += digits[k] * strides[k];
-            }
-            for a in 0..W {
-                let mut value = w[0][a];
-                for k in 1..D {
-                    value *= w[k][digits[k]];
-                }
-                let gradient = SVector::<f64, D>::from_fn(|j, _| {
-                    let mut g = if j == 0 { dw[0][a] } else { w[0][a] };
-                    for k in 1..D {
-                        g *= if k == j {
-                            dw[k][digits[k]]
-                        } else {
-                            w[k][digits[k]]
-                        };
-                    }
-                    g
-                });
-                let offset =
-                    SVector::<f64, D>::from_fn(
-                        |k, _| {
-                            if k == 0 { r[0][a] } else { r[k][digits[k]] }
-                        },
-                    );
-                visit((node + a) as u32, value, &gradient, &offset);
-            }
-            // The next row: an odometer over axes 1..D.
-            let mut k = 1;
-            loop {
-                if k >= D {
-                    return Ok(());
-                }
-                digits[k] += 1;
-                if digits[k] < W {
-                    break;
-                }
-                digits[k] = 0;
-                k += 1;
-            }
-        }
+        self.tensor_of_width::<W>(order, x)?.for_each_entry(visit);
+        Ok(())
     }
 }
 

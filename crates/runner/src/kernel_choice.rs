@@ -17,6 +17,7 @@ use umls_mls::{
     SupportRadius, UmlsKernel,
 };
 use umls_transfer::Kernel;
+use umls_ugimp::{UgimpError, UgimpKernel};
 
 use crate::error::Result;
 use crate::scene::Scene;
@@ -118,6 +119,19 @@ where
     }
     fn build(&self, scene: &Scene, setup: &Setup<D>) -> Result<Self::Kernel> {
         Ok(LinearFeKernel::new(mesh(scene, setup)?))
+    }
+}
+
+impl<const D: usize> KernelFactory<D> for Preset<UgimpKernel<D>> {
+    type Kernel = UgimpKernel<D>;
+    fn name(&self) -> String {
+        self.kind.name().to_string()
+    }
+    fn on_mesh(&self) -> bool {
+        false
+    }
+    fn build(&self, scene: &Scene, setup: &Setup<D>) -> Result<Self::Kernel> {
+        ugimp(scene, setup)
     }
 }
 
@@ -321,8 +335,41 @@ fn umls_preset(kind: KernelKind) -> UmlsPreset {
     }
 }
 
-/// Most nodes a B-spline grid may have (a typo in the spacing should be an error).
+/// Most nodes a grid may have (a typo in the spacing should be an error).
 const MAX_GRID_NODES: f64 = 1e8;
+
+/// The grid spacing of a grid kernel: `[kernel] grid_spacing`, else the lattice's cell
+/// size, else the mesh's longest edge / √D.
+fn grid_spacing<const D: usize>(scene: &Scene, setup: &Setup<D>) -> Result<f64> {
+    let h = scene
+        .spec
+        .kernel
+        .grid_spacing
+        .or(setup.lattice_spacing)
+        .or_else(|| {
+            setup
+                .background
+                .mesh()
+                .map(|mesh| mesh.max_edge_length() / (D as f64).sqrt())
+        })
+        .unwrap_or(f64::NAN);
+    if !(h.is_finite() && h > 0.0) {
+        return Err(scene.value_error("kernel.grid_spacing", "must be positive"));
+    }
+    Ok(h)
+}
+
+/// Refuses a grid of more than [`MAX_GRID_NODES`] nodes.
+fn check_grid_size(scene: &Scene, h: f64, cells: &[usize]) -> Result<()> {
+    let nodes: f64 = cells.iter().map(|&n| n as f64 + 1.0).product();
+    if nodes > MAX_GRID_NODES {
+        return Err(scene.value_error(
+            "kernel.grid_spacing",
+            format!("{h} gives a grid of {nodes:.3e} nodes (limit {MAX_GRID_NODES:.0e})"),
+        ));
+    }
+    Ok(())
+}
 
 /// A B-spline grid covering the mesh's bounding box with two cells of margin (the
 /// widest, cubic, stencil needs one).
@@ -331,35 +378,35 @@ fn bspline<const D: usize>(
     setup: &Setup<D>,
     order: BSplineOrder,
 ) -> Result<BSplineKernel<D>> {
-    let background = &setup.background;
-    let h = scene
-        .spec
-        .kernel
-        .grid_spacing
-        .or(setup.lattice_spacing)
-        .or_else(|| {
-            background
-                .mesh()
-                .map(|mesh| mesh.max_edge_length() / (D as f64).sqrt())
-        })
-        .unwrap_or(f64::NAN);
-    if !(h.is_finite() && h > 0.0) {
-        return Err(scene.value_error("kernel.grid_spacing", "must be positive"));
-    }
-    let (lower, upper) = background.bounding_box();
+    let h = grid_spacing(scene, setup)?;
+    let (lower, upper) = setup.background.bounding_box();
     let kernel = BSplineKernel::covering(lower, upper, h, order).ok_or_else(|| {
-        scene
-            .value_error(
-                "kernel.grid_spacing",
-                "too coarse for one B-spline stencil, or so fine that the grid has more than 2^32 nodes",
-            )
-    })?;
-    let nodes: f64 = kernel.cells().iter().map(|&n| n as f64 + 1.0).product();
-    if nodes > MAX_GRID_NODES {
-        return Err(scene.value_error(
+        scene.value_error(
             "kernel.grid_spacing",
-            format!("{h} gives a grid of {nodes:.3e} nodes (limit {MAX_GRID_NODES:.0e})"),
-        ));
-    }
+            "too coarse for one B-spline stencil, or so fine that the grid has more than 2^32 nodes",
+        )
+    })?;
+    check_grid_size(scene, h, &kernel.cells())?;
+    Ok(kernel)
+}
+
+/// The uGIMP grid covering the background as the B-spline grids do, for particle boxes
+/// of half the particles' initial spacing: l = V̄^(1/D) / 2 with V̄ the mean initial
+/// particle volume (uGIMP keeps one box size; a scene whose bodies are seeded at
+/// different spacings gets their mean).
+fn ugimp<const D: usize>(scene: &Scene, setup: &Setup<D>) -> Result<UgimpKernel<D>> {
+    let h = grid_spacing(scene, setup)?;
+    let volumes = &setup.seeds.volume;
+    let mean = volumes.iter().sum::<f64>() / volumes.len().max(1) as f64;
+    let half_width = 0.5 * mean.powf(1.0 / D as f64);
+    let (lower, upper) = setup.background.bounding_box();
+    let kernel = UgimpKernel::covering(lower, upper, h, half_width).map_err(|e| {
+        let key = match e {
+            UgimpError::HalfWidth { .. } => "bodies.seeding",
+            _ => "kernel.grid_spacing",
+        };
+        scene.value_error(key, format!("ugimp: {e}"))
+    })?;
+    check_grid_size(scene, h, &kernel.cells())?;
     Ok(kernel)
 }

@@ -10,6 +10,7 @@
 use umls_constitutive::table::{MaterialTable, Model, NoPlasticity, PlasticModel, PlasticPart};
 use umls_io::vtk::Encoding;
 use umls_kernels::{BSplineKernel, LinearFeKernel};
+use umls_ugimp::UgimpKernel;
 
 use crate::context::Context;
 pub use crate::context::{History, Progress, RunOptions, RunPlan, RunReport};
@@ -160,6 +161,7 @@ where
     Dim<D>: SceneDimension<D>,
     Preset<LinearFeKernel<D>>: KernelFactory<D>,
     Preset<BSplineKernel<D>>: KernelFactory<D>,
+    Preset<UgimpKernel<D>>: KernelFactory<D>,
     Preset<<Dim<D> as SceneDimension<D>>::Umls>: KernelFactory<D>,
     Preset<<Dim<D> as SceneDimension<D>>::UmlsQuadratic>: KernelFactory<D>,
 {
@@ -171,6 +173,9 @@ where
         }
         KernelKind::LinearFe => {
             with_factory::<D, _>(scene, options, &Preset::<LinearFeKernel<D>>::new(kind))
+        }
+        KernelKind::Ugimp => {
+            with_factory::<D, _>(scene, options, &Preset::<UgimpKernel<D>>::new(kind))
         }
         KernelKind::Bspline2 | KernelKind::Bspline3 => {
             with_factory::<D, _>(scene, options, &Preset::<BSplineKernel<D>>::new(kind))

@@ -229,11 +229,14 @@ pub enum KernelKind {
     Bspline2,
     /// Cubic B-splines on a Cartesian grid covering the mesh.
     Bspline3,
+    /// uGIMP (Bardenhagen & Kober 2004) on the grid the B-splines use: the linear hat
+    /// averaged over each particle's box of half its initial spacing (`umls-ugimp`).
+    Ugimp,
 }
 
 impl KernelKind {
     /// Every preset, in the order the command line lists them.
-    pub const ALL: [KernelKind; 15] = [
+    pub const ALL: [KernelKind; 16] = [
         KernelKind::Umls,
         KernelKind::UmlsQuadratic,
         KernelKind::UmlsWendland,
@@ -249,6 +252,7 @@ impl KernelKind {
         KernelKind::LinearFe,
         KernelKind::Bspline2,
         KernelKind::Bspline3,
+        KernelKind::Ugimp,
     ];
 
     /// The preset named `name` (as in scene files and on the command line).
@@ -274,6 +278,7 @@ impl KernelKind {
             KernelKind::LinearFe => "linear-fe",
             KernelKind::Bspline2 => "bspline2",
             KernelKind::Bspline3 => "bspline3",
+            KernelKind::Ugimp => "ugimp",
         }
     }
 }
