@@ -186,7 +186,29 @@ fn runner_imports() -> std::collections::BTreeMap<String, std::collections::BTre
         if module == "lib" {
             continue;
         }
-        let text = std::fs::read_to_string(&path).unwrap();
+        // A module in a folder (`setup/`) is all its files, its submodules' imports
+        // counted as its own.
+        let text = if path.is_dir() {
+            let mut files: Vec<_> = std::fs::read_dir(&path)
+                .unwrap()
+                .map(|e| e.unwrap().path())
+                .collect();
+            files.sort();
+            assert!(
+                files
+                    .iter()
+                    .all(|f| f.extension().is_some_and(|e| e == "rs")),
+                "{}: one level of submodules is read",
+                path.display()
+            );
+            files
+                .iter()
+                .map(|f| std::fs::read_to_string(f).unwrap())
+                .collect::<Vec<_>>()
+                .join("\n")
+        } else {
+            std::fs::read_to_string(&path).unwrap()
+        };
         let code: String = text
             .lines()
             .filter(|l| !l.trim_start().starts_with("//"))

@@ -33,6 +33,38 @@ mod cpu;
 mod machine;
 mod peers;
 
+/// What `cargo xtask --help` prints: each task, its options and what it produces.
+const USAGE: &str = "\
+Project automation for the umls workspace.
+
+Usage: cargo xtask <TASK> [OPTIONS]
+
+Tasks:
+  ci         Format check, clippy with -D warnings, a build with default features off,
+             the whole test suite in release mode, and the custom-kernel example:
+             what .ci/run runs.
+  bench      The comparison report (scenes x kernels x resolutions: tables, charts,
+             raw results) in target/report/, after the criterion benches of every crate.
+               --quick                 coarse levels only, no criterion benches
+               --no-criterion          reuse the criterion results already there
+               --save-baseline NAME    save the criterion results as NAME
+               --baseline NAME         compare the criterion results with NAME
+               --docs                  copy the report to docs/report/
+  compare    The working tree's speed against revision REV on this machine: short runs
+             of both builds alternated, stage times, ratios, and whether the results
+             stayed bit for bit the same (target/compare/compare.md).
+               REV                     the revision to compare with (required)
+               --rounds N              alternating rounds
+               --threads N             worker threads of each run
+               --case ARGS             `umls run` arguments of a case (repeatable)
+               --fail-above R          fail if a stage is slower than R times REV
+  peers      The fluid box beside Taichi's own example of the scene: throughput and
+             peak memory, ratios to the same round's Taichi run
+             (target/peers/peers.md; Taichi from PyPI into target/peers/venv).
+               --rounds N  --threads N  --steps N  --python PATH
+  deny       cargo deny check (needs `cargo install cargo-deny`).
+  help       This text.";
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
@@ -41,10 +73,16 @@ fn main() -> ExitCode {
         Some("compare") => compare::compare(&args[1..]),
         Some("peers") => peers::peers(&args[1..]),
         Some("deny") => cargo(&["deny", "check"]),
-        _ => {
-            eprintln!(
-                "usage: cargo xtask <ci | bench [--quick] [--no-criterion] [--save-baseline NAME | --baseline NAME] [--docs] | compare REV [--rounds N] [--threads N] [--case ARGS]... [--fail-above R] | peers [--rounds N] [--threads N] [--steps N] [--python PATH] | deny>"
-            );
+        Some("help" | "--help" | "-h") => {
+            println!("{USAGE}");
+            return ExitCode::SUCCESS;
+        }
+        Some(other) => {
+            eprintln!("xtask: unknown task `{other}`\n\n{USAGE}");
+            return ExitCode::from(2);
+        }
+        None => {
+            eprintln!("{USAGE}");
             return ExitCode::from(2);
         }
     };

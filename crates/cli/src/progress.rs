@@ -84,3 +84,39 @@ impl Progress for Bar {
         self.bar.finish_and_clear();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(particles: usize, steps: usize, frames: usize, output_bytes: u64) -> RunPlan {
+        RunPlan {
+            scene: "s".into(),
+            particles,
+            steps,
+            frames,
+            output_bytes,
+            warnings: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_small_run_is_described_without_a_warning() {
+        let (line, warning) = describe(&plan(1000, 2000, 50, 8_550_000));
+        assert_eq!(
+            line,
+            "s: 1000 particles × 2000 steps = 2.00e6 particle-steps; 50 frames, about 0.01 GB of output"
+        );
+        assert_eq!(warning, None);
+    }
+
+    #[test]
+    fn much_output_or_much_work_is_a_warning() {
+        let (_, output) = describe(&plan(1000, 2000, 50, LARGE_OUTPUT_BYTES + 1));
+        assert!(output.unwrap().contains("2.1 GB of frames"));
+        let (_, work) = describe(&plan(1_000_000, 20_000, 2, 1));
+        assert!(work.unwrap().contains("2.0e10 particle-steps"));
+        let (_, edge) = describe(&plan(1, 1, 2, LARGE_OUTPUT_BYTES));
+        assert_eq!(edge, None, "the threshold itself is not large");
+    }
+}

@@ -126,7 +126,19 @@ fn vibrating_bar_writes_readable_files() {
     assert_eq!(s["steps"], 500);
     assert_eq!(s["particles"], 100);
     assert_eq!(s["kernel"], "umls");
-    assert!(s["particle_steps_per_second"].as_f64().unwrap() > 0.0);
+    // Two throughputs, each what its name says: stepping alone, and the run loop's
+    // wall time with the frames written (41 of them here, so the second is lower).
+    let work = 100.0 * 500.0;
+    let stepping = s["particle_steps_per_second"].as_f64().unwrap();
+    let stage_total = s["stage_seconds"]["total"].as_f64().unwrap();
+    assert!(
+        (stepping * stage_total / work - 1.0).abs() < 1e-9,
+        "{stepping}"
+    );
+    let walled = s["particle_steps_per_wall_second"].as_f64().unwrap();
+    let wall = s["wall_time_s"].as_f64().unwrap();
+    assert!((walled * wall / work - 1.0).abs() < 1e-9, "{walled}");
+    assert!(walled < stepping, "{walled} ≥ {stepping}");
     let rmse = s["metrics"]["velocity_rmse"].as_f64().unwrap();
     assert!(rmse > 0.0 && rmse < 2e-3, "{rmse}");
 
@@ -441,6 +453,24 @@ fn mesh_info_reports_and_fails_clearly() {
     assert!(err.contains("line ") && err.contains("$EndNodes"), "{err}");
     assert!(err.contains("bad.msh"), "the file is named: {err}");
 
+    // Two triangles on the unit square with the diagonal's end (1, 1) given twice: read
+    // as written they would meet along a crack, so the reader refuses the file.
+    let cracked = dir.join("cracked.msh");
+    std::fs::write(
+        &cracked,
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 1 1 0\n\
+         4 0 1 0\n7 1 1 0\n$EndNodes\n$Elements\n2\n1 2 2 1 1 1 2 3\n2 2 2 1 1 1 7 4\n\
+         $EndElements\n",
+    )
+    .unwrap();
+    let out = umls(&["mesh-info", cracked.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("cracked.msh") && err.contains("nodes 3 and 7 both lie at (1, 1)"),
+        "{err}"
+    );
+
     // A scene whose mesh file is missing names the scene, the key and the path.
     let scene = dir.join("scene.toml");
     let text = umls_runner::builtin::BUILTIN[2].toml.replacen(
@@ -534,11 +564,11 @@ fn an_unstable_run_leaves_its_history_and_says_why() {
     assert_eq!(time, stopped);
 }
 
-/// Ctrl-C (SIGINT) stops a run after the current step and still writes the last state,
-/// the mesh, the plot and a summary saying "interrupted".
-#[test]
-fn an_interrupted_run_writes_its_output() {
-    let dir = scratch("interrupted");
+/// Starts a long run, sends it `signals` (one `kill` each) once it is stepping, and
+/// checks that it stopped after its current step and still wrote the last state, the
+/// mesh, the plot, the history and a summary saying "interrupted".
+fn interrupted_by(name: &str, signals: &[&str]) {
+    let dir = scratch(name);
     let mut child = Command::new(env!("CARGO_BIN_EXE_umls"))
         .args([
             "run",
@@ -563,11 +593,13 @@ fn an_interrupted_run_writes_its_output() {
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
     std::thread::sleep(std::time::Duration::from_millis(300));
-    let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(status.success());
+    for signal in signals {
+        let status = Command::new("kill")
+            .args([*signal, child.id().to_string().as_str()])
+            .status()
+            .unwrap();
+        assert!(status.success());
+    }
     let start = std::time::Instant::now();
     while child.try_wait().unwrap().is_none() {
         if start.elapsed() > std::time::Duration::from_secs(60) {
@@ -578,14 +610,40 @@ fn an_interrupted_run_writes_its_output() {
     }
     let out = child.wait_with_output().unwrap();
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("interrupted at t ="));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("interrupted at t ="),
+        "{signals:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let s = summary(&dir);
     assert_eq!(s["status"], "interrupted");
-    assert!(s["steps"].as_u64().unwrap() > 0);
+    let steps = s["steps"].as_u64().unwrap();
+    assert!(steps > 0);
     for file in ["mesh.vtu", "energies.svg", "history.csv"] {
         assert!(dir.join(file).exists(), "{file}");
     }
     assert!(frames(&dir).len() >= 2);
+    // The history reaches the step the run stopped at, one row per recorded step.
+    let (_, rows) = history(&dir);
+    assert!(!rows.is_empty(), "{signals:?}: empty history");
+}
+
+/// Ctrl-C (SIGINT) stops a run after the current step and still writes its output.
+#[test]
+fn an_interrupted_run_writes_its_output() {
+    interrupted_by("interrupted", &["-INT"]);
+}
+
+/// SIGTERM, what a scheduler or `kill` sends, is handled like Ctrl-C.
+#[test]
+fn a_terminated_run_writes_its_output() {
+    interrupted_by("terminated", &["-TERM"]);
+}
+
+/// An impatient second Ctrl-C still leaves the output and the summary.
+#[test]
+fn a_double_interrupt_still_writes_its_output() {
+    interrupted_by("interrupted-twice", &["-INT", "-INT"]);
 }
 
 /// The quasi-static keys: a soft column on slip planes, loaded by a gravity ramp, damped,

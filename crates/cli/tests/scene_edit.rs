@@ -140,3 +140,86 @@ fn the_binary_applies_set_and_refine() {
         4 * base["particles"].as_u64().unwrap()
     );
 }
+
+/// Without `--out`, an edited run writes beside the plain run, in a folder tagged by its
+/// edits, instead of over it; the same edits find the same folder again.
+#[test]
+fn an_edited_run_does_not_overwrite_the_plain_one() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("edit_folders");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |extra: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_umls"))
+            .current_dir(&dir)
+            .args(["run", "vibrating-bar", "--quiet", "--end-time", "0.01"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let folders = || {
+        let mut names: Vec<String> = std::fs::read_dir(dir.join("out"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    };
+    run(&[]);
+    run(&["--set", "transfer.kind=flip"]);
+    run(&["--set", "transfer.kind=flip"]);
+    let names = folders();
+    assert_eq!(names.len(), 2, "{names:?}");
+    let plain = &names[0];
+    assert!(plain.starts_with("vibrating-bar-"), "{plain}");
+    let tag = names[1].strip_prefix(&format!("{plain}-")).unwrap();
+    assert!(
+        tag.len() == 8 && tag.chars().all(|c| c.is_ascii_hexdigit()),
+        "{names:?}"
+    );
+    for name in &names {
+        assert!(dir.join("out").join(name).join("summary.json").is_file());
+    }
+}
+
+/// A `--set` that breaks the scene names the key, the assignment and the user's file,
+/// not a line of the edited text the user never saw.
+#[test]
+fn a_bad_assignment_names_its_key_and_the_file() {
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/colliding-disks.toml"
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_umls"))
+        .args([
+            "run",
+            file,
+            "--set",
+            "material.young=abc",
+            "--set",
+            "time.dt=2e-4",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("colliding-disks.toml: `material.young`"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("`--set material.young=abc`"), "{stderr}");
+    assert!(stderr.contains("unknown field `material`"), "{stderr}");
+    assert!(!stderr.contains("line "), "{stderr}");
+    // A wrong type is blamed on its assignment too, the good ones before it are not.
+    let out = Command::new(env!("CARGO_BIN_EXE_umls"))
+        .args(["run", file, "--set", "time.dt=2e-4", "--set", "time.dt=[1"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("`--set time.dt=[1`"), "{stderr}");
+    assert!(stderr.contains("invalid type: string \"[1\""), "{stderr}");
+}

@@ -151,6 +151,21 @@ pub enum IoError {
         /// The mesh dimension.
         dimension: usize,
     },
+    /// Two nodes the cells use lie at the same point: the cells on either side would share
+    /// no vertex there, an internal crack the file most likely does not mean.
+    #[error(
+        "{at}: nodes {first} and {second} both lie at ({point}); cells on either side would not be joined there (an internal crack). Merge duplicate nodes (Gmsh: Coherence Mesh, or Geometry.Tolerance when the CAD has duplicate points)"
+    )]
+    CoincidentNodes {
+        /// Position of the second node's definition.
+        at: Position,
+        /// Tag of the node defined first.
+        first: u64,
+        /// Tag of the node defined later at the same point.
+        second: u64,
+        /// The shared point, as "x, y, z".
+        point: String,
+    },
     /// A lower-dimensional (boundary) element uses a node that no cell uses.
     #[error(
         "element {element} (a {dimension}D element of physical group {group}) uses node {node}, which belongs to no cell"

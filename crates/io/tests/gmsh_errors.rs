@@ -257,3 +257,31 @@ fn dimension_is_taken_from_the_elements() {
     let err = parse_msh_any(points_only.as_bytes(), ReadOptions::default()).unwrap_err();
     assert!(matches!(err, IoError::NoCells { .. }), "{err}");
 }
+
+#[test]
+fn coincident_nodes_are_refused_naming_both_tags_and_the_line() {
+    // The square's second triangle uses node 6, a second node at (1, 1): without the
+    // check the two triangles would meet along a crack from (0, 0) to (1, 1).
+    let text = format!(
+        "{HEADER_22}$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n6 1 1 0\n$EndNodes\n\
+         $Elements\n2\n1 2 2 2 1 1 2 3\n2 2 2 2 1 1 6 4\n$EndElements\n"
+    );
+    let line = text.lines().position(|l| l == "6 1 1 0").unwrap() + 1;
+    let err = read(&text).unwrap_err();
+    assert!(
+        matches!(
+            &err,
+            IoError::CoincidentNodes { first: 3, second: 6, at, .. } if *at == Position::Line(line)
+        ),
+        "{err}"
+    );
+    assert!(
+        err.to_string()
+            .starts_with(&format!("line {line}: nodes 3 and 6 both lie at (1, 1)")),
+        "{err}"
+    );
+    // The same square with node 3 used twice is one mesh without a crack.
+    let joined = text.replace("1 1 6 4", "1 1 3 4");
+    let mesh = read(&joined).unwrap().mesh;
+    assert_eq!(mesh.topology().boundary_facets().len(), 4);
+}

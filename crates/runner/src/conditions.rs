@@ -4,7 +4,7 @@
 //! reported.
 
 use nalgebra::SVector;
-use umls_engine::{FittedClamp, Wall, WallKind, face_points};
+use umls_engine::{FittedClamp, Region, Wall, WallKind, face_points};
 
 use crate::context::Context;
 use crate::error::Result;
@@ -17,85 +17,17 @@ pub(crate) fn apply_boundaries<const D: usize>(
     ctx: &Context<'_, D>,
     sim: &mut dyn Run<D>,
 ) -> Result<()> {
-    let scene = ctx.scene;
-    let mesh_kernel = ctx.mesh_kernel;
     for (i, (kind, target)) in ctx.setup.boundaries.iter().enumerate() {
-        let wall_kind = match kind {
-            BoundaryKind::Fixed => WallKind::Fixed,
-            BoundaryKind::Slip => WallKind::Slip,
-        };
-        match target {
-            BoundaryTarget::Plane { point, normal } => {
-                let tolerance = 1e-6 * sim.spacing();
-                let wall =
-                    Wall::facing(wall_kind, *point, *normal, sim.positions()).ok_or_else(|| {
-                        scene.value_error(
-                            format!("boundaries[{i}].plane.normal"),
-                            "must not be zero",
-                        )
-                    })?;
-                let nodes = sim.add_wall(wall, tolerance);
-                if nodes.is_empty() {
-                    return Err(scene.value_error(
-                        format!("boundaries[{i}].plane"),
-                        format!("no {} node lies on or beyond the plane", ctx.kernel_name),
-                    ));
-                }
-                sim.boundary().reaction_sets.push(nodes);
-            }
-            BoundaryTarget::Vertices(vertices) if !mesh_kernel => {
-                // A grid sees the group as a staircase: its nodes outside the mesh near
-                // the group take the condition, with the nearest group vertex's normal.
-                let Some(mesh) = ctx.setup.background.mesh() else {
-                    return Err(scene.value_error(
-                        format!("boundaries[{i}].group"),
-                        "a group condition needs the mesh it belongs to",
-                    ));
-                };
-                let reach = 3.0 * sim.spacing();
-                let nodes: Vec<(u32, SVector<f64, D>)> = sim
-                    .node_positions()
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, x)| mesh.locate(x).is_none())
-                    .filter_map(|(n, x)| {
-                        vertices
-                            .iter()
-                            .map(|(v, normal)| ((mesh.vertex(*v as usize) - x).norm(), normal))
-                            .min_by(|a, b| a.0.total_cmp(&b.0))
-                            .filter(|(d, _)| *d <= reach)
-                            .map(|(_, normal)| (n as u32, *normal))
-                    })
-                    .collect();
-                if nodes.is_empty() {
-                    return Err(scene.value_error(
-                        format!("boundaries[{i}].group"),
-                        format!(
-                            "no {} node lies outside the mesh near the group",
-                            ctx.kernel_name
-                        ),
-                    ));
-                }
-                match kind {
-                    BoundaryKind::Fixed => {
-                        sim.boundary().fixed.extend(nodes.iter().map(|(n, _)| *n))
-                    }
-                    BoundaryKind::Slip => sim.boundary().slip.extend(nodes.iter().copied()),
-                }
-                sim.boundary()
-                    .reaction_sets
-                    .push(nodes.iter().map(|(n, _)| *n).collect());
+        let nodes = match target {
+            BoundaryTarget::Plane { point, normal } => plane(ctx, sim, i, *kind, point, normal)?,
+            BoundaryTarget::Vertices(vertices) if !ctx.mesh_kernel => {
+                let nodes = staircase(ctx, sim, i, vertices)?;
+                hold(sim, *kind, &nodes);
+                nodes.iter().map(|(n, _)| *n).collect()
             }
             BoundaryTarget::Vertices(vertices) => {
-                match kind {
-                    BoundaryKind::Fixed => sim
-                        .boundary()
-                        .fixed
-                        .extend(vertices.iter().map(|(v, _)| *v)),
-                    BoundaryKind::Slip => sim.boundary().slip.extend(vertices.iter().copied()),
-                }
-                let nodes = vertices.iter().map(|(v, _)| *v).collect();
-                sim.boundary().reaction_sets.push(nodes);
+                hold(sim, *kind, vertices);
+                vertices.iter().map(|(v, _)| *v).collect()
             }
             BoundaryTarget::Region {
                 region,
@@ -103,62 +35,168 @@ pub(crate) fn apply_boundaries<const D: usize>(
                 imposed,
                 penalty,
             } => {
-                let frame = &ctx.setup.frame;
-                // Indices of the points (world frame) inside the region (scene frame).
-                let inside = |points: &[SVector<f64, D>]| -> Vec<u32> {
-                    points
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, x)| region.contains(&frame.point_to_scene(x)))
-                        .map(|(n, _)| n as u32)
-                        .collect()
+                let held = HeldRegion {
+                    region,
+                    normal: normal.as_ref(),
+                    imposed: *imposed,
+                    penalty: *penalty,
                 };
-                let nodes = inside(&sim.node_positions());
-                if nodes.is_empty() {
-                    return Err(scene.value_error(
-                        format!("boundaries[{i}].region"),
-                        format!("holds no {} node", ctx.kernel_name),
-                    ));
-                }
-                match normal {
-                    None if *imposed == Imposed::Face => {
-                        let contains =
-                            |x: &SVector<f64, D>| region.contains(&frame.point_to_scene(x));
-                        let points = face_points(sim.positions(), contains, face_reach(sim));
-                        if points.is_empty() {
-                            return Err(scene.value_error(
-                                format!("boundaries[{i}].imposed"),
-                                "a clamp held on its face needs particles on both sides of the region's boundary",
-                            ));
-                        }
-                        let moved = sim
-                            .add_face_clamp(nodes.clone(), points, *penalty)
-                            .map_err(|e| {
-                                scene.value_error(format!("boundaries[{i}].region"), e.to_string())
-                            })?;
-                        sim.boundary().reaction_sets.push(moved);
-                        continue;
-                    }
-                    None if *imposed == Imposed::Fit => {
-                        let particles = inside(sim.positions());
-                        if particles.is_empty() {
-                            return Err(scene.value_error(
-                                format!("boundaries[{i}].imposed"),
-                                "a clamp imposed on the fit needs particles inside its region",
-                            ));
-                        }
-                        let mut clamp = FittedClamp::new(nodes.clone(), particles);
-                        clamp.reach = sim.spacing();
-                        sim.boundary().fitted.push(clamp);
-                    }
-                    None => sim.boundary().fixed.extend(nodes.iter().copied()),
-                    Some(n) => sim.boundary().slip.extend(nodes.iter().map(|&v| (v, *n))),
-                }
-                sim.boundary().reaction_sets.push(nodes);
+                held.apply(ctx, sim, i)?
             }
-        }
+        };
+        // Each condition's nodes are a reaction set, so its force is reported.
+        sim.boundary().reaction_sets.push(nodes);
     }
     Ok(())
+}
+
+/// A wall on the plane through `point`; returns the nodes it holds.
+fn plane<const D: usize>(
+    ctx: &Context<'_, D>,
+    sim: &mut dyn Run<D>,
+    i: usize,
+    kind: BoundaryKind,
+    point: &SVector<f64, D>,
+    normal: &SVector<f64, D>,
+) -> Result<Vec<u32>> {
+    let wall_kind = match kind {
+        BoundaryKind::Fixed => WallKind::Fixed,
+        BoundaryKind::Slip => WallKind::Slip,
+    };
+    let tolerance = 1e-6 * sim.spacing();
+    let wall = Wall::facing(wall_kind, *point, *normal, sim.positions()).ok_or_else(|| {
+        ctx.scene
+            .value_error(format!("boundaries[{i}].plane.normal"), "must not be zero")
+    })?;
+    let nodes = sim.add_wall(wall, tolerance);
+    if nodes.is_empty() {
+        return Err(ctx.scene.value_error(
+            format!("boundaries[{i}].plane"),
+            format!("no {} node lies on or beyond the plane", ctx.kernel_name),
+        ));
+    }
+    Ok(nodes)
+}
+
+/// Fixes or lets slip the given nodes, each with its wall normal.
+fn hold<const D: usize>(
+    sim: &mut dyn Run<D>,
+    kind: BoundaryKind,
+    nodes: &[(u32, SVector<f64, D>)],
+) {
+    match kind {
+        BoundaryKind::Fixed => sim.boundary().fixed.extend(nodes.iter().map(|(n, _)| *n)),
+        BoundaryKind::Slip => sim.boundary().slip.extend(nodes.iter().copied()),
+    }
+}
+
+/// A mesh group as a grid sees it, a staircase: the grid's nodes outside the mesh within
+/// three spacings of a group vertex, each with its nearest group vertex's normal.
+fn staircase<const D: usize>(
+    ctx: &Context<'_, D>,
+    sim: &dyn Run<D>,
+    i: usize,
+    vertices: &[(u32, SVector<f64, D>)],
+) -> Result<Vec<(u32, SVector<f64, D>)>> {
+    let Some(mesh) = ctx.setup.background.mesh() else {
+        return Err(ctx.scene.value_error(
+            format!("boundaries[{i}].group"),
+            "a group condition needs the mesh it belongs to",
+        ));
+    };
+    let reach = 3.0 * sim.spacing();
+    let nodes: Vec<(u32, SVector<f64, D>)> = sim
+        .node_positions()
+        .iter()
+        .enumerate()
+        .filter(|(_, x)| mesh.locate(x).is_none())
+        .filter_map(|(n, x)| {
+            vertices
+                .iter()
+                .map(|(v, normal)| ((mesh.vertex(*v as usize) - x).norm(), normal))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .filter(|(d, _)| *d <= reach)
+                .map(|(_, normal)| (n as u32, *normal))
+        })
+        .collect();
+    if nodes.is_empty() {
+        return Err(ctx.scene.value_error(
+            format!("boundaries[{i}].group"),
+            format!(
+                "no {} node lies outside the mesh near the group",
+                ctx.kernel_name
+            ),
+        ));
+    }
+    Ok(nodes)
+}
+
+/// A condition on the nodes inside a region of the scene frame.
+struct HeldRegion<'a, const D: usize> {
+    region: &'a Region<D>,
+    normal: Option<&'a SVector<f64, D>>,
+    imposed: Imposed,
+    penalty: Option<f64>,
+}
+
+impl<const D: usize> HeldRegion<'_, D> {
+    /// Holds the region's nodes (fixed, slip, on the fit or on the face); returns the
+    /// reaction set.
+    fn apply(&self, ctx: &Context<'_, D>, sim: &mut dyn Run<D>, i: usize) -> Result<Vec<u32>> {
+        let scene = ctx.scene;
+        let nodes = self.inside(ctx, &sim.node_positions());
+        if nodes.is_empty() {
+            return Err(scene.value_error(
+                format!("boundaries[{i}].region"),
+                format!("holds no {} node", ctx.kernel_name),
+            ));
+        }
+        match self.normal {
+            None if self.imposed == Imposed::Face => {
+                let frame = &ctx.setup.frame;
+                let contains = |x: &SVector<f64, D>| self.region.contains(&frame.point_to_scene(x));
+                let points = face_points(sim.positions(), contains, face_reach(sim));
+                if points.is_empty() {
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].imposed"),
+                        "a clamp held on its face needs particles on both sides of the region's boundary",
+                    ));
+                }
+                // The face clamp moves the nodes it holds; those are the reaction set.
+                return sim
+                    .add_face_clamp(nodes, points, self.penalty)
+                    .map_err(|e| {
+                        scene.value_error(format!("boundaries[{i}].region"), e.to_string())
+                    });
+            }
+            None if self.imposed == Imposed::Fit => {
+                let particles = self.inside(ctx, sim.positions());
+                if particles.is_empty() {
+                    return Err(scene.value_error(
+                        format!("boundaries[{i}].imposed"),
+                        "a clamp imposed on the fit needs particles inside its region",
+                    ));
+                }
+                let mut clamp = FittedClamp::new(nodes.clone(), particles);
+                clamp.reach = sim.spacing();
+                sim.boundary().fitted.push(clamp);
+            }
+            None => sim.boundary().fixed.extend(nodes.iter().copied()),
+            Some(n) => sim.boundary().slip.extend(nodes.iter().map(|&v| (v, *n))),
+        }
+        Ok(nodes)
+    }
+
+    /// Indices of the points (world frame) inside the region (scene frame).
+    fn inside(&self, ctx: &Context<'_, D>, points: &[SVector<f64, D>]) -> Vec<u32> {
+        let frame = &ctx.setup.frame;
+        points
+            .iter()
+            .enumerate()
+            .filter(|(_, x)| self.region.contains(&frame.point_to_scene(x)))
+            .map(|(n, _)| n as u32)
+            .collect()
+    }
 }
 
 /// How far apart two particles may be for a face point between them: 1.5 times the

@@ -88,39 +88,12 @@ impl OutputDir {
             .map(|(x, x0)| x - x0)
             .collect();
         grid.add_point_vectors("displacement", &displacement)?;
-        let kirchhoff = sim.stresses()?;
         let jacobian: Vec<f64> = p
             .deformation
             .iter()
             .map(umls_constitutive::determinant)
             .collect();
-        // Full 3×3 tensors: in 2D the plane-strain σ_zz (not zero) and F_zz = 1; in 1D
-        // (uniaxial stress) σ_yy = σ_zz = 0 and the unknown lateral stretches shown as 1.
-        let mut cauchy = Vec::with_capacity(9 * p.len());
-        let mut mean = Vec::with_capacity(p.len());
-        for (i, ((tau, j), (f, state))) in kirchhoff
-            .iter()
-            .zip(&jacobian)
-            .zip(p.deformation.iter().zip(&p.state))
-            .enumerate()
-        {
-            let zz = if D == 2 {
-                let tau_zz = sim
-                    .material()
-                    .out_of_plane_stress(f, state)
-                    .map_err(|source| umls_engine::EngineError::Material {
-                        step: sim.step_count(),
-                        particle: sim.particle_id(i),
-                        source,
-                    })?;
-                tau_zz / j
-            } else {
-                0.0
-            };
-            let sigma = full_tensor(&(tau / *j), zz);
-            mean.push((sigma[0] + sigma[4] + sigma[8]) / 3.0);
-            cauchy.extend(sigma);
-        }
+        let (cauchy, mean) = cauchy_stresses(sim, &jacobian)?;
         grid.add_point_field("cauchy_stress", 9, cauchy)?;
         grid.add_point_field("mean_stress", 1, mean)?;
         let deformation = p
@@ -143,22 +116,7 @@ impl OutputDir {
             "material",
             p.state.iter().map(|s| i32::from(s.material)).collect(),
         )?;
-        let names = sim.material().state_scalar_names();
-        if !names.is_empty() {
-            let mut values = Vec::with_capacity(p.len() * names.len());
-            for s in &p.state {
-                sim.material().state_scalars(s, &mut values);
-            }
-            for (k, name) in names.iter().enumerate() {
-                let column = values
-                    .iter()
-                    .skip(k)
-                    .step_by(names.len())
-                    .copied()
-                    .collect();
-                grid.add_point_field(name, 1, column)?;
-            }
-        }
+        add_state_fields(sim, &mut grid)?;
         let name = format!("particles_{:05}.vtu", self.frames());
         grid.write_vtu(dir.join(&name), self.encoding)?;
         self.collection.push(sim.time(), name);
@@ -263,4 +221,76 @@ fn full_tensor<const D: usize>(m: &nalgebra::SMatrix<f64, D, D>, rest: f64) -> [
             0.0
         }
     })
+}
+
+/// Cauchy stresses of every particle as full 3×3 tensors (row-major), and their means:
+/// in 2D the plane-strain σ_zz (not zero), in 1D (uniaxial stress) σ_yy = σ_zz = 0.
+fn cauchy_stresses<const D: usize, K, P, T>(
+    sim: &Simulation<D, K, MaterialTable<P>, T>,
+    jacobian: &[f64],
+) -> Result<(Vec<f64>, Vec<f64>)>
+where
+    K: Kernel<D>,
+    P: PlasticPart<D>,
+    T: TransferScheme,
+{
+    let p = sim.particles();
+    let kirchhoff = sim.stresses()?;
+    let mut cauchy = Vec::with_capacity(9 * p.len());
+    let mut mean = Vec::with_capacity(p.len());
+    for (i, ((tau, j), (f, state))) in kirchhoff
+        .iter()
+        .zip(jacobian)
+        .zip(p.deformation.iter().zip(&p.state))
+        .enumerate()
+    {
+        let zz = if D == 2 {
+            let tau_zz = sim
+                .material()
+                .out_of_plane_stress(f, state)
+                .map_err(|source| umls_engine::EngineError::Material {
+                    step: sim.step_count(),
+                    particle: sim.particle_id(i),
+                    source,
+                })?;
+            tau_zz / j
+        } else {
+            0.0
+        };
+        let sigma = full_tensor(&(tau / *j), zz);
+        mean.push((sigma[0] + sigma[4] + sigma[8]) / 3.0);
+        cauchy.extend(sigma);
+    }
+    Ok((cauchy, mean))
+}
+
+/// The material state's scalars (plastic strain, …), one point field each.
+fn add_state_fields<const D: usize, K, P, T>(
+    sim: &Simulation<D, K, MaterialTable<P>, T>,
+    grid: &mut UnstructuredGrid,
+) -> Result<()>
+where
+    K: Kernel<D>,
+    P: PlasticPart<D>,
+    T: TransferScheme,
+{
+    let names = sim.material().state_scalar_names();
+    if names.is_empty() {
+        return Ok(());
+    }
+    let states = &sim.particles().state;
+    let mut values = Vec::with_capacity(states.len() * names.len());
+    for s in states {
+        sim.material().state_scalars(s, &mut values);
+    }
+    for (k, name) in names.iter().enumerate() {
+        let column = values
+            .iter()
+            .skip(k)
+            .step_by(names.len())
+            .copied()
+            .collect();
+        grid.add_point_field(name, 1, column)?;
+    }
+    Ok(())
 }

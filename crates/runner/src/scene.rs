@@ -41,8 +41,37 @@ impl Scene {
     /// [`override_text`]).
     pub fn load_with(name_or_path: &str, assignments: &[(String, String)]) -> Result<Self> {
         let (text, label, base) = Self::text(name_or_path)?;
-        let text = override_text(&text, &label, assignments)?;
-        Self::parse(&text, &label, base)
+        let edited = override_text(&text, &label, assignments)?;
+        Self::parse(&edited, &label, base.clone())
+            .map_err(|error| Self::blame_edit(&text, &label, assignments, error))
+    }
+
+    /// The error of an edited scene that does not parse, told in the user's terms: the
+    /// edited text's line numbers mean nothing to them, so an error an edit caused names
+    /// the first assignment after which the scene no longer parses, and the file.
+    fn blame_edit(
+        text: &str,
+        label: &str,
+        assignments: &[(String, String)],
+        error: RunError,
+    ) -> RunError {
+        if assignments.is_empty() || toml::from_str::<SceneSpec>(text).is_err() {
+            return error;
+        }
+        for n in 1..=assignments.len() {
+            let Ok(edited) = override_text(text, label, &assignments[..n]) else {
+                return error;
+            };
+            if let Err(e) = toml::from_str::<SceneSpec>(&edited) {
+                let (key, value) = &assignments[n - 1];
+                return RunError::SceneValue {
+                    file: label.to_string(),
+                    key: key.clone(),
+                    reason: format!("as set by `--set {key}={value}`: {}", e.message()),
+                };
+            }
+        }
+        error
     }
 
     /// The text of a built-in scene or scene file, its label and its base directory.

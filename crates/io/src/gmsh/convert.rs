@@ -7,6 +7,7 @@ use std::collections::{BTreeMap, HashMap};
 use nalgebra::SVector;
 use umls_mesh::{MeshError, SimplexMesh};
 
+use super::coincident::{COINCIDENCE_TOLERANCE, first_coincident};
 use super::raw::RawMsh;
 use super::{GmshMesh, MshVersion, PhysicalGroup, ReadOptions};
 use crate::error::{IoError, Result};
@@ -96,6 +97,8 @@ pub(crate) fn to_mesh<const D: usize>(
     let mut new_index = vec![u32::MAX; raw.nodes.len()];
     let mut vertices = Vec::new();
     let mut vertex_tags = Vec::new();
+    // The raw node behind each vertex, for messages.
+    let mut vertex_node = Vec::new();
     let extent = raw
         .nodes
         .iter()
@@ -119,6 +122,20 @@ pub(crate) fn to_mesh<const D: usize>(
         new_index[i] = vertices.len() as u32;
         vertices.push(SVector::<f64, D>::from_fn(|k, _| x[k]));
         vertex_tags.push(*tag);
+        vertex_node.push(i);
+    }
+    if let Some((first, second)) = first_coincident(&vertices, COINCIDENCE_TOLERANCE * extent) {
+        let (_, x, at) = &raw.nodes[vertex_node[second]];
+        return Err(IoError::CoincidentNodes {
+            at: *at,
+            first: vertex_tags[first],
+            second: vertex_tags[second],
+            point: x[..D]
+                .iter()
+                .map(|c| format!("{c}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        });
     }
     let vertex_of = |tag: &u64| new_index[node_index[tag]];
 

@@ -9,6 +9,7 @@
 //! because every error must name the line (or byte) and section at fault; the parser is
 //! a few hundred lines over one `cursor` and is fuzzed by the crate's tests.
 
+mod coincident;
 mod convert;
 mod cursor;
 mod format;
