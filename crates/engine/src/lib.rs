@@ -1,7 +1,8 @@
 //! Explicit material point method, generic over dimension, shape-function kernel
 //! ([`umls_transfer::Kernel`]), transfer scheme ([`TransferScheme`]: PIC, FLIP, APIC,
-//! APIC-FLIP, quadratic APIC ([`quadratic_modes`]), velocity-gradient affine, MLS-MPM)
-//! and material ([`umls_constitutive::Constitutive`]).
+//! APIC-FLIP, quadratic APIC ([`quadratic_modes`]), velocity-gradient affine, MLS-MPM,
+//! each a type of its own or any of them chosen at run time as an [`AnyTransfer`]) and
+//! material ([`umls_constitutive::Constitutive`]).
 //!
 //! One [`Simulation::step`]: evaluate every particle's stencil (in parallel, walking from
 //! its cached host), P2G of mass, momentum (with the affine term, and the quadratic
@@ -83,6 +84,6 @@ pub use settings::{Damping, MassMatrix, StencilStorage, StepSettings, TimeStepCo
 pub use simulation::{BodyForce, Simulation};
 pub use timing::StageTimes;
 pub use transfer::{
-    AffineTransfer, Apic, ApicFlip, Flip, MlsMpm, Pic, QuadraticApic, QuadraticApicFlip,
-    SingularSecondMoment, StressUpdate, TransferScheme, VelocityGradientAffine,
+    AnyTransfer, Apic, ApicFlip, Flip, MlsMpm, Pic, QuadraticApic, QuadraticApicFlip,
+    SingularSecondMoment, StressUpdate, TransferScheme, TransferShape, VelocityGradientAffine,
 };

@@ -1,5 +1,6 @@
 //! The explicit MPM step (symplectic Euler), generic over dimension, kernel, transfer
-//! scheme and material, so a scene compiles to exactly the code it needs.
+//! scheme and material. The transfer's [`crate::TransferShape`] is read at run time, so
+//! one simulation type can serve every scheme ([`crate::AnyTransfer`]).
 
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
@@ -49,7 +50,7 @@ fn check_transfer<const D: usize, K: Kernel<D>, T: TransferScheme>(
     kernel: &K,
     settings: &StepSettings<D>,
 ) -> Result<(), EngineError> {
-    if !T::FUSED_FORCE {
+    if !transfer.shape().fused_force {
         return Ok(());
     }
     let unsupported = |setting, reason| {
@@ -555,7 +556,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // The kernel and settings are public fields: a combination the transfer cannot
         // work with may have been set since construction.
         check_transfer(&self.transfer, &self.kernel, &self.settings)?;
-        if T::QUADRATIC {
+        let shape = self.transfer.shape();
+        if shape.quadratic {
             // One set of modes per particle, zero for particles given without them
             // (a no-op once sized).
             let n = self.particles.len();
@@ -600,8 +602,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 &self.kernel,
                 storage,
                 (
-                    T::AFFINE && self.kernel.constant_second_moment().is_none(),
-                    !T::FUSED_FORCE,
+                    shape.affine && self.kernel.constant_second_moment().is_none(),
+                    !shape.fused_force,
                 ),
                 &self.particles.position,
                 &mut self.particles.cache,
@@ -636,7 +638,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         }
         self.boundary.sort_by_node();
         // Only FLIP's G2P reads the velocities before the update.
-        self.grid.keep_velocity = T::USES_FLIP;
+        self.grid.keep_velocity = shape.uses_flip;
         let report = self.grid.update(
             dt,
             self.material.p_wave_modulus(),

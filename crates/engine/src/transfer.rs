@@ -1,22 +1,29 @@
-//! Particle-grid transfer schemes (behind a trait, so each scheme compiles to its own
-//! code) and the stress-update variants.
+//! Particle-grid transfer schemes behind a trait: each a type of its own, or any of them
+//! as the run-time value [`AnyTransfer`], whose [`TransferShape`] the step reads (the
+//! tensor-product row sums compiled per shape); and the stress-update variants.
 
 use nalgebra::{SMatrix, SVector};
 use umls_transfer::regular_inverse;
 
 /// A velocity transfer scheme: how particle momentum reaches the grid and how grid
 /// velocities come back to the particle.
-pub trait TransferScheme: Copy + Send + Sync + std::fmt::Debug {
+/// What a transfer scheme reads and writes, which decides the work of P2G and G2P.
+///
+/// A value rather than associated constants, so that one simulation type can run any
+/// scheme chosen at run time ([`AnyTransfer`]): the loops that would pay for a branch
+/// on it (G2P's particle loop, P2G's stencil sums, the tensor-product row sums) are
+/// still compiled per shape and chosen once per chunk or particle, while the rest of
+/// the step, which does not depend on it, is compiled once.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TransferShape {
     /// Whether the affine matrix C_p enters P2G: (mv)_i += N m_p (v_p + C_p (x_i − x_p)).
-    const AFFINE: bool;
-
-    /// Whether [`Self::affine`] reads B_p and D_p; G2P skips accumulating them otherwise.
-    const USES_MOMENTS: bool = false;
-
-    /// Whether [`Self::velocity`] reads the FLIP increment; G2P skips reading the old
-    /// grid velocities otherwise.
-    const USES_FLIP: bool = false;
-
+    pub affine: bool,
+    /// Whether [`TransferScheme::affine`] reads B_p and D_p; G2P skips accumulating them
+    /// otherwise.
+    pub uses_moments: bool,
+    /// Whether [`TransferScheme::velocity`] reads the FLIP increment; G2P skips reading
+    /// the old grid velocities otherwise.
+    pub uses_flip: bool,
     /// Whether P2G folds the internal force into the affine momentum (MLS-MPM, Hu et al.
     /// 2018): ∇N_i is taken as D_p⁻¹ N_i (x_i − x_p), so the stress impulse
     /// −Δt V τ ∇N_i joins the term P2G spreads anyway, N_i (m C − Δt V τ D_p⁻¹)(x_i − x_p),
@@ -26,12 +33,65 @@ pub trait TransferScheme: Copy + Send + Sync + std::fmt::Debug {
     /// the grid update then sees no separate force, so damping and selective mass
     /// scaling do not act, and MUSL's re-mapped gradient would be another scheme
     /// ([`crate::Simulation::new`] refuses those combinations).
-    const FUSED_FORCE: bool = false;
-
+    pub fused_force: bool,
     /// Whether the particles carry quadratic velocity modes besides C_p
     /// ([`crate::quadratic_modes`]): G2P fits their coefficients Q_p, and P2G spreads
     /// (mv)_i += N m_p (v_p + C_p r + Σ_k Q_pk q_k(r)).
-    const QUADRATIC: bool = false;
+    pub quadratic: bool,
+}
+
+impl TransferShape {
+    /// No affine field, no FLIP increment: PIC.
+    pub const PIC: Self = Self {
+        affine: false,
+        uses_moments: false,
+        uses_flip: false,
+        fused_force: false,
+        quadratic: false,
+    };
+    /// FLIP: PIC's shape with the FLIP increment.
+    pub const FLIP: Self = Self {
+        uses_flip: true,
+        ..Self::PIC
+    };
+    /// APIC: the affine field from the moments B_p and D_p.
+    pub const APIC: Self = Self {
+        affine: true,
+        uses_moments: true,
+        ..Self::PIC
+    };
+    /// APIC blended with FLIP.
+    pub const APIC_FLIP: Self = Self {
+        uses_flip: true,
+        ..Self::APIC
+    };
+    /// MLS-MPM: APIC's shape with the force folded into the momentum.
+    pub const MLS_MPM: Self = Self {
+        fused_force: true,
+        ..Self::APIC
+    };
+    /// The affine field from the velocity gradient, without the moments.
+    pub const VELOCITY_GRADIENT: Self = Self {
+        affine: true,
+        ..Self::PIC
+    };
+    /// APIC with quadratic modes.
+    pub const QUADRATIC_APIC: Self = Self {
+        quadratic: true,
+        ..Self::APIC
+    };
+    /// Quadratic APIC blended with FLIP.
+    pub const QUADRATIC_APIC_FLIP: Self = Self {
+        uses_flip: true,
+        ..Self::QUADRATIC_APIC
+    };
+}
+
+/// A velocity transfer scheme: how particle momentum reaches the grid and how grid
+/// velocities come back to the particle.
+pub trait TransferScheme: Copy + Send + Sync + std::fmt::Debug {
+    /// What the scheme reads and writes. A scheme of fixed shape returns a constant.
+    fn shape(&self) -> TransferShape;
 
     /// Short name for reports.
     fn name(&self) -> &'static str;
@@ -96,7 +156,7 @@ pub struct Flip {
 pub struct Apic;
 
 /// MLS-MPM (Hu et al. 2018, Taichi's `mpm88`/`mpm3d`): APIC's transfers with the
-/// internal force folded into the affine momentum ([`TransferScheme::FUSED_FORCE`]) and
+/// internal force folded into the affine momentum ([`TransferShape::fused_force`]) and
 /// ∇v = C_p. For quadratic B-splines D_p⁻¹ N_i (x_i − x_p) is an O(h) approximation of
 /// ∇N_i (exact for linear velocity fields), so results differ from APIC's at that order
 /// for about half the per-node arithmetic. With an MLS kernel (UMLS) D_p is each
@@ -146,15 +206,20 @@ pub struct QuadraticApicFlip {
 pub struct VelocityGradientAffine;
 
 impl TransferScheme for Pic {
-    const AFFINE: bool = false;
+    #[inline]
+    fn shape(&self) -> TransferShape {
+        TransferShape::PIC
+    }
     fn name(&self) -> &'static str {
         "PIC"
     }
 }
 
 impl TransferScheme for Flip {
-    const AFFINE: bool = false;
-    const USES_FLIP: bool = true;
+    #[inline]
+    fn shape(&self) -> TransferShape {
+        TransferShape::FLIP
+    }
     fn name(&self) -> &'static str {
         "FLIP"
     }
@@ -169,8 +234,10 @@ impl TransferScheme for Flip {
 }
 
 impl TransferScheme for Apic {
-    const AFFINE: bool = true;
-    const USES_MOMENTS: bool = true;
+    #[inline]
+    fn shape(&self) -> TransferShape {
+        TransferShape::APIC
+    }
     fn name(&self) -> &'static str {
         "APIC"
     }
@@ -272,9 +339,10 @@ macro_rules! flip_velocity {
 }
 
 impl TransferScheme for MlsMpm {
-    const AFFINE: bool = true;
-    const USES_MOMENTS: bool = true;
-    const FUSED_FORCE: bool = true;
+    #[inline]
+    fn shape(&self) -> TransferShape {
+        TransferShape::MLS_MPM
+    }
     fn name(&self) -> &'static str {
         "MLS-MPM"
     }
@@ -282,9 +350,10 @@ impl TransferScheme for MlsMpm {
 }
 
 impl TransferScheme for ApicFlip {
-    const AFFINE: bool = true;
-    const USES_MOMENTS: bool = true;
-    const USES_FLIP: bool = true;
+    #[inline]
+    fn shape(&self) -> TransferShape {
+        TransferShape::APIC_FLIP
+    }
     fn name(&self) -> &'static str {
         "APIC-FLIP"
     }
@@ -293,9 +362,10 @@ impl TransferScheme for ApicFlip {
 }
 
 impl TransferScheme for QuadraticApic {
-    const AFFINE: bool = true;
-    const USES_MOMENTS: bool = true;
-    const QUADRATIC: bool = true;
+    #[inline]
+    fn shape(&self) -> TransferShape {
+        TransferShape::QUADRATIC_APIC
+    }
     fn name(&self) -> &'static str {
         "quadratic APIC"
     }
@@ -303,10 +373,10 @@ impl TransferScheme for QuadraticApic {
 }
 
 impl TransferScheme for QuadraticApicFlip {
-    const AFFINE: bool = true;
-    const USES_MOMENTS: bool = true;
-    const USES_FLIP: bool = true;
-    const QUADRATIC: bool = true;
+    #[inline]
+    fn shape(&self) -> TransferShape {
+        TransferShape::QUADRATIC_APIC_FLIP
+    }
     fn name(&self) -> &'static str {
         "quadratic APIC-FLIP"
     }
@@ -315,7 +385,10 @@ impl TransferScheme for QuadraticApicFlip {
 }
 
 impl TransferScheme for VelocityGradientAffine {
-    const AFFINE: bool = true;
+    #[inline]
+    fn shape(&self) -> TransferShape {
+        TransferShape::VELOCITY_GRADIENT
+    }
     fn name(&self) -> &'static str {
         "affine (velocity gradient)"
     }
@@ -407,53 +480,98 @@ mod tests {
     }
 }
 
-/// APIC or the velocity-gradient affine transfer, chosen at run time. Both carry C_p; the
-/// moments B_p and D_p are accumulated for both although only APIC reads them (a few
-/// flops per node, against a second copy of every simulation type of a program that offers
-/// both).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum AffineTransfer {
+/// Any of the schemes above, chosen at run time: one simulation type for every scheme,
+/// so that a program offering all of them (the scene runner) compiles the step once per
+/// kernel and material rather than once per scheme as well ([`TransferShape`] says
+/// which loops are still compiled per shape).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AnyTransfer {
+    /// [`Pic`].
+    Pic,
+    /// [`Flip`] with its α.
+    Flip(Flip),
     /// [`Apic`].
     Apic,
+    /// [`ApicFlip`] with its α.
+    ApicFlip(ApicFlip),
+    /// [`MlsMpm`].
+    MlsMpm,
     /// [`VelocityGradientAffine`].
     VelocityGradient,
+    /// [`QuadraticApic`].
+    QuadraticApic,
+    /// [`QuadraticApicFlip`] with its α.
+    QuadraticApicFlip(QuadraticApicFlip),
 }
 
-impl TransferScheme for AffineTransfer {
-    const AFFINE: bool = true;
-    const USES_MOMENTS: bool = true;
-
-    fn name(&self) -> &'static str {
-        match self {
-            Self::Apic => Apic.name(),
-            Self::VelocityGradient => VelocityGradientAffine.name(),
+/// Calls `$call` on the scheme inside an [`AnyTransfer`].
+macro_rules! each_scheme {
+    ($self:expr, $t:ident => $call:expr) => {
+        match $self {
+            AnyTransfer::Pic => {
+                let $t = Pic;
+                $call
+            }
+            AnyTransfer::Flip($t) => $call,
+            AnyTransfer::Apic => {
+                let $t = Apic;
+                $call
+            }
+            AnyTransfer::ApicFlip($t) => $call,
+            AnyTransfer::MlsMpm => {
+                let $t = MlsMpm;
+                $call
+            }
+            AnyTransfer::VelocityGradient => {
+                let $t = VelocityGradientAffine;
+                $call
+            }
+            AnyTransfer::QuadraticApic => {
+                let $t = QuadraticApic;
+                $call
+            }
+            AnyTransfer::QuadraticApicFlip($t) => $call,
         }
+    };
+}
+
+impl TransferScheme for AnyTransfer {
+    #[inline]
+    fn shape(&self) -> TransferShape {
+        each_scheme!(self, t => t.shape())
     }
 
+    fn name(&self) -> &'static str {
+        each_scheme!(self, t => t.name())
+    }
+
+    #[inline]
+    fn velocity<const D: usize>(
+        &self,
+        old: &SVector<f64, D>,
+        pic: &SVector<f64, D>,
+        flip_increment: &SVector<f64, D>,
+    ) -> SVector<f64, D> {
+        each_scheme!(self, t => t.velocity(old, pic, flip_increment))
+    }
+
+    #[inline]
     fn affine<const D: usize>(
         &self,
         b: &SMatrix<f64, D, D>,
         d: &SMatrix<f64, D, D>,
         grad_v: &SMatrix<f64, D, D>,
     ) -> SMatrix<f64, D, D> {
-        match self {
-            Self::Apic => Apic.affine(b, d, grad_v),
-            Self::VelocityGradient => VelocityGradientAffine.affine(b, d, grad_v),
-        }
+        each_scheme!(self, t => t.affine(b, d, grad_v))
     }
 
+    #[inline]
     fn affine_with_constant_moment<const D: usize>(
         &self,
         b: &SMatrix<f64, D, D>,
         s: f64,
         grad_v: &SMatrix<f64, D, D>,
     ) -> SMatrix<f64, D, D> {
-        // Each scheme's own closed form (APIC: B_p / s, no Cholesky factorisation).
-        match self {
-            Self::Apic => Apic.affine_with_constant_moment(b, s, grad_v),
-            Self::VelocityGradient => {
-                VelocityGradientAffine.affine_with_constant_moment(b, s, grad_v)
-            }
-        }
+        each_scheme!(self, t => t.affine_with_constant_moment(b, s, grad_v))
     }
 }

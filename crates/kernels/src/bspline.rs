@@ -201,6 +201,7 @@ impl<const D: usize> BSplineKernel<D> {
 
 impl<const D: usize> Kernel<D> for BSplineKernel<D> {
     type Cache = ();
+    const MAY_CORRECT_FORCE_GRADIENTS: bool = false;
 
     fn node_count(&self) -> usize {
         self.cells.iter().map(|n| n + 1).product()

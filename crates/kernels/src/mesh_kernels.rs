@@ -363,6 +363,7 @@ where
     W: WeightFunction,
 {
     type Cache = HostCache<D>;
+    const MAY_BE_TENSOR_PRODUCT: bool = false;
 
     mesh_nodes!();
 
@@ -531,6 +532,8 @@ impl<const D: usize> LinearFeKernel<D> {
 
 impl<const D: usize> Kernel<D> for LinearFeKernel<D> {
     type Cache = HostCache<D>;
+    const MAY_BE_TENSOR_PRODUCT: bool = false;
+    const MAY_CORRECT_FORCE_GRADIENTS: bool = false;
 
     mesh_nodes!();
 

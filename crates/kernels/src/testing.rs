@@ -28,6 +28,8 @@
 //! - tensor-product stencils (`Kernel::tensor_width`, widths 1 to 6) whose per-axis
 //!   factors give the stencil's nodes, values, gradients and offsets bit for bit (as
 //!   products in axis order), and `KernelError::NotTensorProduct` for any other width;
+//! - `Kernel::MAY_BE_TENSOR_PRODUCT` and `Kernel::MAY_CORRECT_FORCE_GRADIENTS` true
+//!   wherever the kernel has a tensor width or a force-gradient correction;
 //! - a typed `KernelError::OutsideDomain` far outside.
 //!
 //! ```
@@ -94,6 +96,14 @@ pub fn check_kernel<const D: usize, K: Kernel<D>>(
     points: &[SVector<f64, D>],
     outside: SVector<f64, D>,
 ) -> Result<(), Violation> {
+    if kernel.force_gradient_correction().is_some() && !K::MAY_CORRECT_FORCE_GRADIENTS {
+        return Err(Violation {
+            point: Vec::new(),
+            message: "a force-gradient correction, though the type declares \
+                      MAY_CORRECT_FORCE_GRADIENTS = false (the engine would drop it)"
+                .into(),
+        });
+    }
     let mut cache = K::Cache::default();
     let (mut st, mut fresh) = (Stencil::new(), Stencil::new());
     let h = kernel.spacing();
@@ -332,6 +342,13 @@ fn check_tensor<const D: usize, K: Kernel<D>>(
     st: &Stencil<D>,
 ) -> Result<(), String> {
     let declared = kernel.tensor_width();
+    if declared.is_some() && !K::MAY_BE_TENSOR_PRODUCT {
+        return Err(
+            "a tensor width, though the type declares MAY_BE_TENSOR_PRODUCT = false (the \
+             engine would never take its row sums)"
+                .into(),
+        );
+    }
     let mut outcomes = [
         tensor_of_width::<D, K, 1>(kernel, x, st, declared),
         tensor_of_width::<D, K, 2>(kernel, x, st, declared),

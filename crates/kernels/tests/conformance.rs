@@ -381,3 +381,51 @@ fn the_public_suite_catches_broken_kernels() {
         .contains("visit_stencil")
     );
 }
+
+/// A kernel type that declares it never corrects its force gradients, yet has a
+/// correction, fails the suite: the engine would leave the correction out.
+#[test]
+fn the_public_suite_catches_a_false_declaration() {
+    struct Liar {
+        correction: [SVector<f64, 1>; 2],
+    }
+    impl Kernel<1> for Liar {
+        type Cache = ();
+        const MAY_CORRECT_FORCE_GRADIENTS: bool = false;
+        fn node_count(&self) -> usize {
+            2
+        }
+        fn node_position(&self, node: usize) -> SVector<f64, 1> {
+            SVector::from([node as f64])
+        }
+        fn spacing(&self) -> f64 {
+            1.0
+        }
+        fn force_gradient_correction(&self) -> Option<&[SVector<f64, 1>]> {
+            Some(&self.correction)
+        }
+        fn stencil(
+            &self,
+            x: &SVector<f64, 1>,
+            _: &mut (),
+            out: &mut Stencil<1>,
+        ) -> Result<(), umls_transfer::KernelError> {
+            if !(0.0..=1.0).contains(&x[0]) {
+                return Err(umls_transfer::KernelError::OutsideDomain { point: vec![x[0]] });
+            }
+            out.clear();
+            out.push(0, 1.0 - x[0], SVector::from([-1.0]), SVector::from([-x[0]]));
+            out.push(1, x[0], SVector::from([1.0]), SVector::from([1.0 - x[0]]));
+            Ok(())
+        }
+    }
+    let liar = Liar {
+        correction: [SVector::from([0.1]), SVector::from([-0.1])],
+    };
+    let err = check_kernel(&liar, &[SVector::from([0.3])], SVector::from([5.0])).unwrap_err();
+    assert!(
+        err.message.contains("MAY_CORRECT_FORCE_GRADIENTS = false"),
+        "{}",
+        err.message
+    );
+}

@@ -1,13 +1,13 @@
-//! The material table and the transfer scheme of a run: the last two types of its
-//! simulation, chosen from the scene, and the simulation built from the set-up's seeds.
+//! The material table and the transfer scheme of a run, chosen from the scene (the
+//! scheme as a value: one simulation type serves all of them), and the simulation built
+//! from the set-up's seeds.
 
 use std::sync::Arc;
 
 use nalgebra::SVector;
 use umls_constitutive::table::{MaterialTable, PlasticPart, TableState};
 use umls_engine::{
-    AffineTransfer, ApicFlip, Flip, MlsMpm, Particles, QuadraticApicFlip, Simulation, StepSettings,
-    TransferScheme,
+    AnyTransfer, ApicFlip, Flip, Particles, QuadraticApicFlip, Simulation, StepSettings,
 };
 use umls_transfer::Kernel;
 
@@ -20,30 +20,27 @@ pub(crate) fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
     kernel: K,
     table: MaterialTable<P>,
 ) -> Result<RunReport> {
-    // Five transfer types for the eight kinds keep down the simulations this crate
-    // compiles: PIC is FLIP with α = 0 (v = 0·(v + Δv) + 1·v_PIC, the same numbers), the
-    // two affine schemes share one type, and quadratic APIC is its FLIP blend at α = 0
-    // (the same bits, tested in the engine). APIC-FLIP has its own type, so that APIC
-    // does not read the old grid velocities it has no use for; MLS-MPM has its own, as
-    // its force is folded into the momentum.
+    // One transfer type for the eight kinds: the scheme is chosen at run time, so the
+    // step is compiled once per kernel and material table, not once per scheme as well
+    // (`AnyTransfer`: the row sums where a branch per node would cost are compiled per
+    // scheme inside the engine).
     let t = &ctx.scene.spec.transfer;
     if !(0.0..=1.0).contains(&t.alpha) {
         return Err(ctx
             .scene
             .value_error("transfer.alpha", format!("{} is not in [0, 1]", t.alpha)));
     }
-    match t.kind {
-        TransferKind::Pic => start(ctx, kernel, table, Flip { alpha: 0.0 }),
-        TransferKind::Flip => start(ctx, kernel, table, Flip { alpha: t.alpha }),
-        TransferKind::ApicFlip => start(ctx, kernel, table, ApicFlip { alpha: t.alpha }),
-        TransferKind::Apic => start(ctx, kernel, table, AffineTransfer::Apic),
-        TransferKind::QuadraticApic => start(ctx, kernel, table, QuadraticApicFlip { alpha: 0.0 }),
+    let alpha = t.alpha;
+    let transfer = match t.kind {
+        TransferKind::Pic => AnyTransfer::Pic,
+        TransferKind::Flip => AnyTransfer::Flip(Flip { alpha }),
+        TransferKind::ApicFlip => AnyTransfer::ApicFlip(ApicFlip { alpha }),
+        TransferKind::Apic => AnyTransfer::Apic,
+        TransferKind::QuadraticApic => AnyTransfer::QuadraticApic,
         TransferKind::QuadraticApicFlip => {
-            start(ctx, kernel, table, QuadraticApicFlip { alpha: t.alpha })
+            AnyTransfer::QuadraticApicFlip(QuadraticApicFlip { alpha })
         }
-        TransferKind::VelocityGradient => {
-            start(ctx, kernel, table, AffineTransfer::VelocityGradient)
-        }
+        TransferKind::VelocityGradient => AnyTransfer::VelocityGradient,
         TransferKind::MlsMpm => {
             if !kernel.regular_second_moment() {
                 return Err(ctx.scene.value_error(
@@ -52,18 +49,19 @@ pub(crate) fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
                      elements' D_p vanishes at the vertices: it needs a B-spline or UMLS kernel",
                 ));
             }
-            start(ctx, kernel, table, MlsMpm)
+            AnyTransfer::MlsMpm
         }
-    }
+    };
+    start(ctx, kernel, table, transfer)
 }
 
 /// The typed part of a run: particles of the table's state and the kernel's cache, and
 /// the simulation, handed to the run loop as a [`Run`].
-fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>, T: TransferScheme>(
+fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
     ctx: &Context<'_, D>,
     kernel: K,
     table: MaterialTable<P>,
-    transfer: T,
+    transfer: AnyTransfer,
 ) -> Result<RunReport> {
     let seeds = &ctx.setup.seeds;
     let mut particles = Particles::<D, TableState<P::State>, K::Cache>::at_rest(

@@ -165,6 +165,15 @@ pub trait Kernel<const D: usize>: Send + Sync {
     /// Per-particle location cache (host simplex, grid cell, or `()`).
     type Cache: Copy + Default + Send + Sync + std::fmt::Debug;
 
+    /// Whether [`Self::tensor_width`] can be `Some` for a kernel of this type. `false`
+    /// lets the engine leave out the row-by-row transfers it would never take (a smaller
+    /// program, not a faster one); the default `true` is always correct.
+    const MAY_BE_TENSOR_PRODUCT: bool = true;
+
+    /// Whether [`Self::force_gradient_correction`] can be `Some` for a kernel of this
+    /// type; `false` lets the engine leave out the corrected P2G. Default `true`.
+    const MAY_CORRECT_FORCE_GRADIENTS: bool = true;
+
     /// Number of nodes.
     fn node_count(&self) -> usize;
 

@@ -14,7 +14,7 @@ use crate::error::EngineError;
 use crate::parallel::lowest_failure;
 use crate::quadratic_modes::{ModeSums, QuadraticModes};
 use crate::stencils::{EntrySink, Stencils};
-use crate::transfer::{SingularSecondMoment, StressUpdate, TransferScheme};
+use crate::transfer::{SingularSecondMoment, StressUpdate, TransferScheme, TransferShape};
 
 /// What G2P computes for one particle.
 #[derive(Debug, Clone, Copy)]
@@ -51,31 +51,52 @@ struct GatherSums<'a, const D: usize, T> {
     transfer: std::marker::PhantomData<T>,
 }
 
-impl<const D: usize, T: TransferScheme> EntrySink<D> for GatherSums<'_, D, T> {
+impl<const D: usize, T> GatherSums<'_, D, T> {
+    /// One entry's share of the sums, compiled for a transfer that reads the FLIP
+    /// increment (`FLIP`) or not, and takes ∇v from C_p (`FUSED`) or sums it.
     #[inline(always)]
-    fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, r: &SVector<f64, D>) {
+    fn add<const FLIP: bool, const FUSED: bool>(
+        &mut self,
+        node: u32,
+        n: f64,
+        gradient: &SVector<f64, D>,
+        r: &SVector<f64, D>,
+    ) {
         let node = node as usize;
         let v = self.grid.new[node];
         self.pic += v * n;
-        if T::USES_FLIP {
+        if FLIP {
             self.flip += (v - self.grid.old[node]) * n;
         }
-        if !T::FUSED_FORCE {
+        if !FUSED {
             self.grad_v += v * gradient.transpose();
         }
         if self.offsets {
             if self.sum_moment {
                 self.d += r * r.transpose() * n;
             }
-            if T::USES_MOMENTS {
-                self.b += v * r.transpose() * n;
-            }
-            if T::QUADRATIC {
-                if let Some(modes) = &mut self.modes {
-                    modes.add(n, &v, r);
-                }
+            // Summed for every scheme with offsets, B_p's readers and the
+            // velocity-gradient transfer alike (a few flops per node against a branch).
+            self.b += v * r.transpose() * n;
+            if let Some(modes) = &mut self.modes {
+                modes.add(n, &v, r);
             }
         }
+    }
+}
+
+/// [`GatherSums`] with the transfer's flags as constants, so the stencil's loop has no
+/// branch on them.
+struct Specialised<'s, 'g, const D: usize, T, const FLIP: bool, const FUSED: bool>(
+    &'s mut GatherSums<'g, D, T>,
+);
+
+impl<const D: usize, T, const FLIP: bool, const FUSED: bool> EntrySink<D>
+    for Specialised<'_, '_, D, T, FLIP, FUSED>
+{
+    #[inline(always)]
+    fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, r: &SVector<f64, D>) {
+        self.0.add::<FLIP, FUSED>(node, n, gradient, r);
     }
 }
 
@@ -83,13 +104,14 @@ impl<const D: usize, T: TransferScheme> EntrySink<D> for GatherSums<'_, D, T> {
 /// visited once (recomputed ones without being stored, [`Stencils::visit`]).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
+fn gather<const D: usize, K: Kernel<D>, T: TransferScheme, const FLIP: bool, const FUSED: bool>(
     stencils: &Stencils<D>,
     p: usize,
     cache: &K::Cache,
     scratch: &mut Stencil<D>,
     kernel: &K,
     transfer: &T,
+    shape: TransferShape,
     grid: &GridVelocities<'_, D>,
     x: SVector<f64, D>,
     old: &SVector<f64, D>,
@@ -97,7 +119,7 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
     modes_out: Option<&mut QuadraticModes<D>>,
 ) -> Result<ParticleUpdate<D>, (usize, KernelError)> {
     let moment_scale = kernel.constant_second_moment();
-    let offsets = T::AFFINE && (T::USES_MOMENTS || moment_scale.is_none());
+    let offsets = shape.affine && (shape.uses_moments || moment_scale.is_none());
     let stored_moment = stencils.stored_second_moment(p);
     let new_sums = || GatherSums::<D, T> {
         grid,
@@ -112,7 +134,7 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
             (None, Some(d)) => *d,
             (None, None) => SMatrix::zeros(),
         },
-        modes: T::QUADRATIC.then(ModeSums::default),
+        modes: shape.quadratic.then(ModeSums::default),
         transfer: std::marker::PhantomData,
     };
     // A tensor-product stencil that is not stored is summed row by row, where D_p is
@@ -120,16 +142,30 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
     // takes: they stay in registers (through `visit`, whose other modes pass the sink
     // to the kernel, they were reloaded from memory at every entry).
     let tensor_width = row_width(kernel).filter(|_| {
-        stencils.recomputed() && (moment_scale.is_some() || !T::AFFINE) && !T::QUADRATIC
+        stencils.recomputed() && (moment_scale.is_some() || !shape.affine) && !shape.quadratic
     });
-    let sums = if let Some(width) = tensor_width {
-        let (pic, flip, grad_v, b) = match width {
-            3 => gather_rows::<D, 3, T>(
+    // The row sums are compiled only for kernel types that may have them.
+    let sums = if K::MAY_BE_TENSOR_PRODUCT
+        && let Some(width) = tensor_width
+    {
+        // The rows compiled for this loop's FLIP and FUSED, and for whether B_p is read.
+        let (pic, flip, grad_v, b) = match (width, shape.uses_moments) {
+            (3, false) => gather_rows::<D, 3, false, FUSED, FLIP>(
                 &kernel.tensor_stencil::<3>(&x).map_err(|e| (p, e))?,
                 grid.new,
                 grid.old,
             ),
-            _ => gather_rows::<D, 4, T>(
+            (3, true) => gather_rows::<D, 3, true, FUSED, FLIP>(
+                &kernel.tensor_stencil::<3>(&x).map_err(|e| (p, e))?,
+                grid.new,
+                grid.old,
+            ),
+            (_, false) => gather_rows::<D, 4, false, FUSED, FLIP>(
+                &kernel.tensor_stencil::<4>(&x).map_err(|e| (p, e))?,
+                grid.new,
+                grid.old,
+            ),
+            (_, true) => gather_rows::<D, 4, true, FUSED, FLIP>(
                 &kernel.tensor_stencil::<4>(&x).map_err(|e| (p, e))?,
                 grid.new,
                 grid.old,
@@ -144,11 +180,13 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
         }
     } else if stencils.stores_entries() {
         let mut sums = new_sums();
-        stencils.visit_entries(p, kernel, &x, offsets, &mut sums);
+        let sink = &mut Specialised::<_, _, FLIP, FUSED>(&mut sums);
+        stencils.visit_entries(p, kernel, &x, offsets, sink);
         sums
     } else {
         let mut sums = new_sums();
-        stencils.visit(p, kernel, &x, cache, scratch, offsets, &mut sums)?;
+        let sink = &mut Specialised::<_, _, FLIP, FUSED>(&mut sums);
+        stencils.visit(p, kernel, &x, cache, scratch, offsets, sink)?;
         sums
     };
     let GatherSums {
@@ -162,35 +200,42 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme>(
     } = sums;
     // The modes' energy joins C_p's in the moment P2G's limiter reads.
     let mut mode_energy = 0.0;
-    if T::QUADRATIC {
+    if shape.quadratic {
         if let (Some(out), Some(modes)) = (modes_out, modes) {
             (*out, mode_energy) = modes.fit(&pic, &b, &d);
         }
     }
+    // Read through the shape, so that a scheme chosen at run time ([`AnyTransfer`]) is
+    // asked only what its shape says it answers.
     let affine = match moment_scale {
+        _ if !shape.affine => SMatrix::zeros(),
         Some(s) => transfer.affine_with_constant_moment(&b, s, &grad_v),
         // MLS-MPM's C_p is also its velocity gradient, so it has no fallback where D_p
         // is singular (APIC's is ∇v): the particle is reported, as P2G reports it.
-        None if T::FUSED_FORCE => {
+        None if FUSED => {
             b * regular_inverse(&d).ok_or_else(|| (p, SingularSecondMoment::of::<D, K>(&d)))?
         }
         None => transfer.affine(&b, &d, &grad_v),
     };
     Ok(ParticleUpdate {
-        velocity: transfer.velocity(old, &pic, &flip),
+        velocity: if FLIP {
+            transfer.velocity(old, &pic, &flip)
+        } else {
+            pic
+        },
         position: x + pic * dt,
         // tr(C D Cᵀ), which P2G's limiter compares with at the next position; with
         // D = s I it is s |C|² (and P2G reads it only where D varies or quadratic modes
         // add their energy).
         affine_moment: mode_energy
-            + match (T::AFFINE, moment_scale) {
+            + match (shape.affine, moment_scale) {
                 (false, _) => 0.0,
                 (true, Some(s)) => s * affine.norm_squared(),
                 (true, None) => (affine * d * affine.transpose()).trace(),
             },
         affine,
         // MLS-MPM takes C_p as the velocity gradient (its ∇N is D⁻¹ N r).
-        velocity_gradient: if T::FUSED_FORCE { affine } else { grad_v },
+        velocity_gradient: if FUSED { affine } else { grad_v },
     })
 }
 
@@ -232,6 +277,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let mut stress_slots = std::mem::take(&mut self.stress_buffer);
         stress_slots.resize(self.particles.len(), SMatrix::zeros());
         let (kernel, transfer, stencils) = (&self.kernel, self.transfer, &self.stencils);
+        let shape = transfer.shape();
+        let quadratic = shape.quadratic;
         let grid = GridVelocities {
             old: &self.grid.velocity,
             new: &self.grid.new_velocity,
@@ -305,85 +352,103 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     // A failing update does not stop the chunk, as in
                     // [`Simulation::update_deformation`].
                     let mut deformation_failure = None;
-                    for k in 0..n {
-                        let i = c * chunk + k;
-                        let x = position[k];
-                        let u = gather(
-                            stencils,
-                            i,
-                            &cache[k],
-                            &mut scratch,
-                            kernel,
-                            &transfer,
-                            &grid,
-                            x,
-                            &velocity[k],
-                            dt,
-                            modes
-                                .as_deref_mut()
-                                .filter(|_| T::QUADRATIC)
-                                .map(|m| &mut m[k]),
-                        )?;
-                        let acceleration = body.get(i).map_or(gravity, |b| gravity + b);
-                        power += mass[k] * acceleration.dot(&(velocity[k] + u.velocity)) * 0.5;
-                        let moved = (u.position - x).norm_squared();
-                        if moved > longest.1 {
-                            longest = (i, moved);
-                        }
-                        velocity[k] = u.velocity;
-                        position[k] = u.position;
-                        affine[k] = u.affine;
-                        moment[k] = u.affine_moment;
-                        if deform {
-                            // The particle's stress slot takes its next stress (under
-                            // MUSL its velocity gradient, which the re-map replaces).
-                            match update_one(
-                                material,
-                                &mut fs[k],
-                                &mut states[k],
-                                &u.velocity_gradient,
-                                &mut slot[k],
-                                dt,
-                                step,
-                                i,
-                            ) {
-                                Ok(det) => {
-                                    min_density = min_density.min(mass[k] / (volume[k] * det));
+                    // The loop compiled for the transfer's shape (the FLIP increment read
+                    // or not, the force fused or not), chosen once per chunk: no branch
+                    // on it per particle or stencil entry.
+                    macro_rules! particles {
+                        ($flip:literal, $fused:literal) => {
+                            for k in 0..n {
+                                let i = c * chunk + k;
+                                let x = position[k];
+                                let u = gather::<D, K, T, $flip, $fused>(
+                                    stencils,
+                                    i,
+                                    &cache[k],
+                                    &mut scratch,
+                                    kernel,
+                                    &transfer,
+                                    shape,
+                                    &grid,
+                                    x,
+                                    &velocity[k],
+                                    dt,
+                                    modes
+                                        .as_deref_mut()
+                                        .filter(|_| quadratic)
+                                        .map(|m| &mut m[k]),
+                                )?;
+                                let acceleration = body.get(i).map_or(gravity, |b| gravity + b);
+                                power +=
+                                    mass[k] * acceleration.dot(&(velocity[k] + u.velocity)) * 0.5;
+                                let moved = (u.position - x).norm_squared();
+                                if moved > longest.1 {
+                                    longest = (i, moved);
                                 }
-                                Err(e) => {
-                                    deformation_failure.get_or_insert((i, e));
+                                velocity[k] = u.velocity;
+                                position[k] = u.position;
+                                affine[k] = u.affine;
+                                moment[k] = u.affine_moment;
+                                if deform {
+                                    // The particle's stress slot takes its next stress (under
+                                    // MUSL its velocity gradient, which the re-map replaces).
+                                    match update_one(
+                                        material,
+                                        &mut fs[k],
+                                        &mut states[k],
+                                        &u.velocity_gradient,
+                                        &mut slot[k],
+                                        dt,
+                                        step,
+                                        i,
+                                    ) {
+                                        Ok(det) => {
+                                            min_density =
+                                                min_density.min(mass[k] / (volume[k] * det));
+                                        }
+                                        Err(e) => {
+                                            deformation_failure.get_or_insert((i, e));
+                                        }
+                                    }
+                                } else {
+                                    slot[k] = u.velocity_gradient;
                                 }
-                            }
-                        } else {
-                            slot[k] = u.velocity_gradient;
-                        }
-                        if boundary.hold(&mut position[k], &mut velocity[k]) {
-                            corrections += 1;
-                        }
-                        if conditions {
-                            if let Some(exit) = kernel.domain_exit(&position[k], &mut cache[k]) {
-                                if Boundary::hold_at_facet(
-                                    marks.get_or_init(|| boundary.node_marks(nodes)),
-                                    &exit,
-                                    &mut position[k],
-                                    &mut velocity[k],
-                                ) {
+                                if boundary.hold(&mut position[k], &mut velocity[k]) {
                                     corrections += 1;
                                 }
+                                if conditions {
+                                    if let Some(exit) =
+                                        kernel.domain_exit(&position[k], &mut cache[k])
+                                    {
+                                        if Boundary::hold_at_facet(
+                                            marks.get_or_init(|| boundary.node_marks(nodes)),
+                                            &exit,
+                                            &mut position[k],
+                                            &mut velocity[k],
+                                        ) {
+                                            corrections += 1;
+                                        }
+                                    }
+                                }
+                                let speed = velocity[k].norm_squared();
+                                if speed > fastest.1 {
+                                    fastest = (i, speed);
+                                }
+                                if non_finite.is_none()
+                                    && !velocity[k]
+                                        .iter()
+                                        .chain(position[k].iter())
+                                        .all(|c| c.is_finite())
+                                {
+                                    non_finite = Some(i);
+                                }
                             }
-                        }
-                        let speed = velocity[k].norm_squared();
-                        if speed > fastest.1 {
-                            fastest = (i, speed);
-                        }
-                        if non_finite.is_none()
-                            && !velocity[k]
-                                .iter()
-                                .chain(position[k].iter())
-                                .all(|c| c.is_finite())
-                        {
-                            non_finite = Some(i);
-                        }
+                        };
+                    }
+                    match (shape.uses_flip, shape.fused_force) {
+                        (false, false) => particles!(false, false),
+                        (true, false) => particles!(true, false),
+                        (false, true) => particles!(false, true),
+                        (true, true) => particles!(true, true),
                     }
                     Ok(vec![ChunkTotals {
                         power,

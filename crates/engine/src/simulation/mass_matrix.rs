@@ -88,7 +88,8 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         let velocity = mass.velocity_iterations();
         if velocity > 0 {
             let mut momentum = std::mem::take(&mut self.grid.momentum);
-            let solved = self.solve_mass_matrix(&mut momentum, velocity, 1.0, T::AFFINE);
+            let solved =
+                self.solve_mass_matrix(&mut momentum, velocity, 1.0, self.transfer.shape().affine);
             self.grid.momentum = momentum;
             solved?;
         }
@@ -158,6 +159,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             &self.ids,
         );
         let moment_scale = kernel.constant_second_moment();
+        let quadratic = transfer.shape().quadratic;
         for _ in 0..iterations {
             let velocity = &solve.velocity;
             let sums = NodalSums {
@@ -183,8 +185,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                             let mut value = SVector::<f64, D>::zeros();
                             let (mut b, mut d, mut grad_v) =
                                 (SMatrix::zeros(), SMatrix::zeros(), SMatrix::zeros());
-                            let mut mode_sums =
-                                (affine && T::QUADRATIC).then(ModeSums::<D>::default);
+                            let mut mode_sums = (affine && quadratic).then(ModeSums::<D>::default);
                             for e in 0..st.len() {
                                 let (n, v) = (st.values[e], velocity[st.nodes[e] as usize]);
                                 value += v * n;

@@ -7,7 +7,7 @@ use umls_constitutive::Constitutive;
 use umls_transfer::{Kernel, KernelError, Stencil, regular_inverse};
 
 use super::Simulation;
-use super::tensor_rows::{ParticleLoad, row_width, scatter_rows};
+use super::tensor_rows::{ParticleLoad, row_width, scatter_rows_for};
 use crate::error::EngineError;
 use crate::quadratic_modes::{ModeFrame, QuadraticModes};
 use crate::scatter::Window;
@@ -87,13 +87,21 @@ struct ScatterEntry<'w, const D: usize, T, const CORRECTED: bool, const A: usize
     transfer: std::marker::PhantomData<T>,
 }
 
-impl<const D: usize, T: TransferScheme, const CORRECTED: bool, const A: usize> EntrySink<D>
-    for ScatterEntry<'_, D, T, CORRECTED, A>
+impl<const D: usize, T: TransferScheme, const CORRECTED: bool, const A: usize>
+    ScatterEntry<'_, D, T, CORRECTED, A>
 {
+    /// One entry's share, compiled for a transfer that spreads C_p (`AFFINE`) or not,
+    /// and folds the force into the momentum (`FUSED`) or not.
     #[inline(always)]
-    fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, r: &SVector<f64, D>) {
+    fn add<const AFFINE: bool, const FUSED: bool>(
+        &mut self,
+        node: u32,
+        n: f64,
+        gradient: &SVector<f64, D>,
+        r: &SVector<f64, D>,
+    ) {
         let m = self.load.mass;
-        if T::FUSED_FORCE {
+        if FUSED {
             // `velocity` is m (v + Δt a) and `affine` m C − Δt V τ D⁻¹ here.
             let momentum = self.load.velocity + self.load.affine * r;
             let k = self.window.record(node as usize);
@@ -102,13 +110,11 @@ impl<const D: usize, T: TransferScheme, const CORRECTED: bool, const A: usize> E
             return;
         }
         let mut mv = self.load.velocity;
-        if T::AFFINE {
+        if AFFINE {
             mv += self.load.affine * r;
         }
-        if T::QUADRATIC {
-            if let Some((frame, modes)) = &self.modes {
-                mv += frame.velocity(modes, r);
-            }
+        if let Some((frame, modes)) = &self.modes {
+            mv += frame.velocity(modes, r);
         }
         let corrected;
         let gradient = if CORRECTED {
@@ -129,24 +135,80 @@ impl<const D: usize, T: TransferScheme, const CORRECTED: bool, const A: usize> E
     }
 }
 
+/// [`ScatterEntry`] with the transfer's flags as constants, so the stencil's loop has no
+/// branch on them.
+struct Specialised<
+    's,
+    'w,
+    const D: usize,
+    T: TransferScheme,
+    const CORRECTED: bool,
+    const A: usize,
+    const AFFINE: bool,
+    const FUSED: bool,
+>(&'s mut ScatterEntry<'w, D, T, CORRECTED, A>);
+
+impl<
+    const D: usize,
+    T: TransferScheme,
+    const CORRECTED: bool,
+    const A: usize,
+    const AFFINE: bool,
+    const FUSED: bool,
+> EntrySink<D> for Specialised<'_, '_, D, T, CORRECTED, A, AFFINE, FUSED>
+{
+    #[inline(always)]
+    fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, r: &SVector<f64, D>) {
+        self.0.add::<AFFINE, FUSED>(node, n, gradient, r);
+    }
+}
+
+/// Runs `$visit` with `$sink` bound to the entry `$entry` specialised for `$shape`: the
+/// flags are read once per particle, not at every entry.
+macro_rules! specialised {
+    ($shape:expr, $entry:expr, $sink:ident => $visit:expr) => {
+        match ($shape.affine, $shape.fused_force) {
+            (false, false) => {
+                let $sink = &mut Specialised::<_, _, _, _, false, false>($entry);
+                $visit
+            }
+            (true, false) => {
+                let $sink = &mut Specialised::<_, _, _, _, true, false>($entry);
+                $visit
+            }
+            (affine, true) => {
+                if affine {
+                    let $sink = &mut Specialised::<_, _, _, _, true, true>($entry);
+                    $visit
+                } else {
+                    let $sink = &mut Specialised::<_, _, _, _, false, true>($entry);
+                    $visit
+                }
+            }
+        }
+    };
+}
+
 impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simulation<D, K, M, T> {
     /// P2G into the grid's mass, |N|-mass (unless the kernel's values are never
     /// negative), stiffness, momentum and force.
     pub(super) fn particles_to_grid(&mut self) -> Result<(), EngineError> {
         let nonnegative = self.kernel.nonnegative_values();
         self.grid.abs_mass_is_mass = nonnegative;
-        self.grid.momentum_only = T::FUSED_FORCE;
+        let fused = self.transfer.shape().fused_force;
+        self.grid.momentum_only = fused;
         // MLS-MPM's gradient is D_p⁻¹ N_i r_i, not the kernel's, so the kernel's
         // correction of its gradient does not apply.
-        let corrected = self
-            .kernel
-            .force_gradient_correction()
-            .filter(|_| !T::FUSED_FORCE);
-        match (corrected, nonnegative) {
-            (Some(_), false) => self.scatter_particles::<true, 1>(),
-            (Some(_), true) => self.scatter_particles::<true, 0>(),
-            (None, false) => self.scatter_particles::<false, 1>(),
-            (None, true) => self.scatter_particles::<false, 0>(),
+        let corrected = self.kernel.force_gradient_correction().filter(|_| !fused);
+        // The corrected P2G is compiled only for kernel types that may correct.
+        match (
+            K::MAY_CORRECT_FORCE_GRADIENTS && corrected.is_some(),
+            nonnegative,
+        ) {
+            (true, false) if K::MAY_CORRECT_FORCE_GRADIENTS => self.scatter_particles::<true, 1>(),
+            (true, true) if K::MAY_CORRECT_FORCE_GRADIENTS => self.scatter_particles::<true, 0>(),
+            (_, false) => self.scatter_particles::<false, 1>(),
+            (_, true) => self.scatter_particles::<false, 0>(),
         }
     }
 
@@ -155,6 +217,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     fn scatter_particles<const CORRECTED: bool, const A: usize>(
         &mut self,
     ) -> Result<(), EngineError> {
+        let shape = self.transfer.shape();
         let stresses = &self.stress_buffer;
         let p = &self.particles;
         let (stencils, kernel, time, step) = (&self.stencils, &self.kernel, self.time, self.step);
@@ -169,7 +232,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             momentum: &mut g.momentum,
             force: &mut g.force,
             live: &mut g.live,
-            momentum_only: T::FUSED_FORCE,
+            momentum_only: shape.fused_force,
             nonnegative: A == 0,
         };
         // With a constant second moment (B-splines) the affine energy cannot grow as a
@@ -184,7 +247,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // ([`scatter_rows`]), where no entry-wise correction, |N|-mass or limiter needs
         // the entries one by one.
         // (Nor quadratic modes, whose frame P2G evaluates from the whole stencil.)
-        let entrywise = CORRECTED || (T::AFFINE && varying_moment) || T::QUADRATIC;
+        let entrywise = CORRECTED || (shape.affine && varying_moment) || shape.quadratic;
         let tensor_width =
             row_width(kernel).filter(|_| A == 0 && !entrywise && stencils.recomputed());
         // Summed row by row, the blocks' windows can be boxes of the kernel's lattice.
@@ -220,14 +283,16 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     // The limiter and the correction's ξ̄_p read the whole stencil before
                     // the first entry, unless the stencil stage stored what they need.
                     // (Quadratic modes have a limiter of their own, below.)
-                    let limiter_reads =
-                        T::AFFINE && varying_moment && stored_moment.is_none() && !T::QUADRATIC;
+                    let limiter_reads = shape.affine
+                        && varying_moment
+                        && stored_moment.is_none()
+                        && !shape.quadratic;
                     let stored_mean = correction.and(stencils.stored_correction_mean(i));
                     let mean_reads = correction.is_some() && stored_mean.is_none();
                     if let Some(mean) = stored_mean {
                         sink.correction_mean = *mean;
                     }
-                    if T::FUSED_FORCE {
+                    if shape.fused_force {
                         // MLS-MPM: ∇N_i ≈ D⁻¹ N_i r_i folds the stress impulse into the
                         // affine term, and gravity into the momentum.
                         sink.load.velocity = (v + acceleration * dt) * m;
@@ -246,33 +311,36 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                             .map_err(|e| (i, e))?;
                         }
                         // Otherwise D_p is summed from the stencil below (`limiter_reads`).
-                    } else if let Some(d) = stored_moment.filter(|_| T::AFFINE) {
+                    } else if let Some(d) = stored_moment.filter(|_| shape.affine) {
                         // D_p summed with the stencil ([`Stencils::compute`]): the entries
                         // are visited once.
                         sink.load.affine = limited_affine(&p.affine[i], p.affine_moment[i], || *d);
-                    } else if T::AFFINE && !limiter_reads {
+                    } else if shape.affine && !limiter_reads {
                         sink.load.affine = p.affine[i];
                     }
-                    if let Some(width) = tensor_width {
+                    // The row sums are compiled only for kernel types that may have them.
+                    if K::MAY_BE_TENSOR_PRODUCT
+                        && let Some(width) = tensor_width
+                    {
                         let (window, load) = (&mut *sink.window, &sink.load);
                         match width {
                             3 => {
                                 let t = kernel.tensor_stencil::<3>(&x).map_err(|e| (i, e))?;
-                                scatter_rows::<D, 3, T>(&t, window, load);
+                                scatter_rows_for::<D, 3>(shape, &t, window, load);
                             }
                             _ => {
                                 let t = kernel.tensor_stencil::<4>(&x).map_err(|e| (i, e))?;
-                                scatter_rows::<D, 4, T>(&t, window, load);
+                                scatter_rows_for::<D, 4>(shape, &t, window, load);
                             }
                         }
-                    } else if limiter_reads || mean_reads || T::QUADRATIC {
+                    } else if limiter_reads || mean_reads || shape.quadratic {
                         // One evaluation serves the whole-stencil sums and the entries.
                         stencils
                             .with(i, kernel, &x, &p.cache[i], &mut scratch, |st| {
                                 if let Some(xi) = correction.filter(|_| mean_reads) {
                                     sink.correction_mean = correction_mean(&st, xi);
                                 }
-                                if T::FUSED_FORCE && limiter_reads {
+                                if shape.fused_force && limiter_reads {
                                     let d = second_moment(&st, kernel, &x);
                                     sink.load.affine = fused_affine::<D, K>(
                                         &p.affine[i],
@@ -287,7 +355,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                             second_moment(&st, kernel, &x)
                                         });
                                 }
-                                if T::QUADRATIC {
+                                if shape.quadratic {
                                     // The modes' frame at the particle's new position, and one
                                     // limit for C_p and the modes together.
                                     let entries = || {
@@ -309,23 +377,30 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                                         sink.modes = Some((frame, modes.map(|m| m * limit)));
                                     }
                                 }
-                                for e in 0..st.len() {
-                                    let r = st.offset(e, kernel, &x);
-                                    sink.entry(st.nodes[e], st.values[e], &st.gradients[e], &r);
-                                }
+                                specialised!(shape, &mut sink, entries => {
+                                    for e in 0..st.len() {
+                                        let r = st.offset(e, kernel, &x);
+                                        entries.entry(
+                                            st.nodes[e],
+                                            st.values[e],
+                                            &st.gradients[e],
+                                            &r,
+                                        );
+                                    }
+                                });
                                 Ok(())
                             })?
                             .map_err(|e| (i, e))?;
                     } else {
-                        stencils.visit(
+                        specialised!(shape, &mut sink, entries => stencils.visit(
                             i,
                             kernel,
                             &x,
                             &p.cache[i],
                             &mut scratch,
-                            T::AFFINE,
-                            &mut sink,
-                        )?;
+                            shape.affine,
+                            entries,
+                        ))?;
                     }
                 }
                 Ok(())

@@ -15,7 +15,7 @@ use nalgebra::{SMatrix, SVector};
 use umls_transfer::{Kernel, TensorStencil};
 
 use crate::scatter::Window;
-use crate::transfer::TransferScheme;
+use crate::transfer::TransferShape;
 
 /// The width of `kernel`'s tensor-product stencils where P2G and G2P sum them row by row:
 /// 3 or 4 nodes per axis (quadratic and cubic B-splines), the widths they dispatch on.
@@ -106,12 +106,34 @@ pub(super) struct ParticleLoad<const D: usize> {
     pub acceleration: SVector<f64, D>,
 }
 
-/// P2G of one particle over `t` into `window` (a kernel with values ≥ 0: no |N|-mass
-/// apart). Under MLS-MPM (`T::FUSED_FORCE`) the mass N m and the momentum
-/// N (p + A (x_i − x)); otherwise the mass, the stiffness V |∇N|², the momentum
-/// N m (v + C (x_i − x)) and the force N m a − V τ ∇N.
+/// [`scatter_rows`] compiled for the transfer's shape: a branch per particle here
+/// rather than per node in the rows.
 #[inline(always)]
-pub(super) fn scatter_rows<const D: usize, const W: usize, T: TransferScheme>(
+pub(super) fn scatter_rows_for<const D: usize, const W: usize>(
+    shape: TransferShape,
+    t: &TensorStencil<D, W>,
+    window: &mut Window<D>,
+    load: &ParticleLoad<D>,
+) {
+    match (shape.affine, shape.fused_force) {
+        (affine, true) => {
+            if affine {
+                scatter_rows::<D, W, true, true>(t, window, load)
+            } else {
+                scatter_rows::<D, W, false, true>(t, window, load)
+            }
+        }
+        (true, false) => scatter_rows::<D, W, true, false>(t, window, load),
+        (false, false) => scatter_rows::<D, W, false, false>(t, window, load),
+    }
+}
+
+/// P2G of one particle over `t` into `window` (a kernel with values ≥ 0: no |N|-mass
+/// apart). Under MLS-MPM (`FUSED`) the mass N m and the momentum N (p + A (x_i − x));
+/// otherwise the mass, the stiffness V |∇N|², the momentum N m (v + C (x_i − x)) and
+/// the force N m a − V τ ∇N. `AFFINE`: whether C enters the momentum.
+#[inline(always)]
+fn scatter_rows<const D: usize, const W: usize, const AFFINE: bool, const FUSED: bool>(
     t: &TensorStencil<D, W>,
     window: &mut Window<D>,
     load: &ParticleLoad<D>,
@@ -126,7 +148,7 @@ pub(super) fn scatter_rows<const D: usize, const W: usize, T: TransferScheme>(
         // The momentum (per unit N m, or per unit N under MLS-MPM) without axis 0's
         // share of C r.
         let mut base: [f64; D] = std::array::from_fn(|j| load.velocity[j]);
-        if T::AFFINE {
+        if AFFINE {
             for k in 1..D {
                 let r = t.offsets[k][digits[k]];
                 for j in 0..D {
@@ -134,7 +156,7 @@ pub(super) fn scatter_rows<const D: usize, const W: usize, T: TransferScheme>(
                 }
             }
         }
-        if T::FUSED_FORCE {
+        if FUSED {
             for a in 0..W {
                 let n = t.values[0][a] * weight;
                 let nm = n * m;
@@ -159,7 +181,7 @@ pub(super) fn scatter_rows<const D: usize, const W: usize, T: TransferScheme>(
                 let g0 = t.derivatives[0][a] * weight;
                 let r = t.offsets[0][a];
                 let momentum = SVector::<f64, D>::from_fn(|j, _| {
-                    if T::AFFINE {
+                    if AFFINE {
                         (base[j] + c[0][j] * r) * nm
                     } else {
                         base[j] * nm
@@ -179,12 +201,18 @@ pub(super) fn scatter_rows<const D: usize, const W: usize, T: TransferScheme>(
 }
 
 /// G2P's sums over `t` from the grid velocities before (`old`) and after (`new`) the
-/// grid update: Σ N ṽ_i; Σ N (ṽ_i − v_i) if the scheme uses FLIP (else zero);
-/// ∇v = Σ ṽ_i ∇N_iᵀ unless it is MLS-MPM (else zero); B = Σ N ṽ_i (x_i − x)ᵀ if it
-/// uses moments (else zero).
+/// grid update: Σ N ṽ_i; Σ N (ṽ_i − v_i) if the scheme uses FLIP (`FLIP`, else zero);
+/// ∇v = Σ ṽ_i ∇N_iᵀ unless it is MLS-MPM (`FUSED`, else zero); B = Σ N ṽ_i (x_i − x)ᵀ
+/// if it uses moments (`MOMENTS`, else zero).
 #[inline(always)]
 #[allow(clippy::type_complexity)]
-pub(super) fn gather_rows<const D: usize, const W: usize, T: TransferScheme>(
+pub(super) fn gather_rows<
+    const D: usize,
+    const W: usize,
+    const MOMENTS: bool,
+    const FUSED: bool,
+    const FLIP: bool,
+>(
     t: &TensorStencil<D, W>,
     new: &[SVector<f64, D>],
     old: &[SVector<f64, D>],
@@ -214,36 +242,36 @@ pub(super) fn gather_rows<const D: usize, const W: usize, T: TransferScheme>(
             for j in 0..D {
                 let v = velocities[a][j];
                 row[j] = fma(v, w, row[j]);
-                if T::USES_MOMENTS {
+                if MOMENTS {
                     row_moment[j] = fma(v, wr, row_moment[j]);
                 }
-                if !T::FUSED_FORCE {
+                if !FUSED {
                     row_derivative[j] = fma(v, dw, row_derivative[j]);
                 }
-                if T::USES_FLIP {
+                if FLIP {
                     row_flip[j] = fma(v - old[node + a][j], w, row_flip[j]);
                 }
             }
         }
         for j in 0..D {
             pic[j] = fma(row[j], weight, pic[j]);
-            if T::USES_FLIP {
+            if FLIP {
                 flip[j] = fma(row_flip[j], weight, flip[j]);
             }
-            if T::USES_MOMENTS {
+            if MOMENTS {
                 b[0][j] = fma(row_moment[j], weight, b[0][j]);
             }
-            if !T::FUSED_FORCE {
+            if !FUSED {
                 grad_v[0][j] = fma(row_derivative[j], weight, grad_v[0][j]);
             }
         }
         for k in 1..D {
             let offset = weight * t.offsets[k][digits[k]];
             for j in 0..D {
-                if T::USES_MOMENTS {
+                if MOMENTS {
                     b[k][j] = fma(row[j], offset, b[k][j]);
                 }
-                if !T::FUSED_FORCE {
+                if !FUSED {
                     grad_v[k][j] = fma(row[j], gradient[k], grad_v[k][j]);
                 }
             }
