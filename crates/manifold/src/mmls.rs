@@ -177,6 +177,20 @@ impl ManifoldMls {
                 reason: "the polynomial has more coefficients than the cloud has distinct samples",
             });
         }
+        // K* = ⌈c · C(d + m, d)⌉ + 1 neighbours per query, checked in floating point
+        // before it becomes a count: a huge c must be an error here, not an overflow at
+        // the first query, and a K* beyond the cloud would make every σ the cloud's
+        // diameter (a global fit whose cost grows with the cloud at each query).
+        if let Bandwidth::Neighbours { factor, .. } = settings.bandwidth {
+            if (factor * monomials.len() as f64).ceil() + 1.0 > positions as f64 {
+                return Err(ManifoldError::InvalidParameter {
+                    parameter: "bandwidth factor c",
+                    value: factor,
+                    reason: "K* = c · C(d + m, d) + 1 neighbours exceed the cloud's distinct \
+                             samples: lower c or the degree m, or give more samples",
+                });
+            }
+        }
         let index = NeighbourIndex::over(
             &cloud,
             distinct.as_ref().map(|group| group.representatives.clone()),

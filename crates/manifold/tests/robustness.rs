@@ -264,6 +264,27 @@ fn edges_of_the_api() {
             ..
         })
     ));
+    // A neighbour count beyond the cloud, from a huge factor or a high degree, is refused
+    // naming the factor, before any query (c = 10¹⁹ once overflowed at the first one).
+    let settings = |factor: f64, degree: usize| Settings {
+        bandwidth: Bandwidth::Neighbours { factor, scale: 2.0 },
+        ..Settings::new(2, degree)
+    };
+    for (factor, degree) in [(1e19, 1), (f64::MAX, 1), (3.0, 20), (167.0, 1)] {
+        let refused = ManifoldMls::new(cloud.clone(), settings(factor, degree)).unwrap_err();
+        assert!(
+            matches!(
+                refused,
+                ManifoldError::InvalidParameter {
+                    parameter: "bandwidth factor c",
+                    ..
+                }
+            ),
+            "c = {factor}, m = {degree}: {refused}"
+        );
+    }
+    // Within the 500 samples: K* = 3 · 166 + 1 = 499 neighbours.
+    assert!(ManifoldMls::new(cloud.clone(), settings(166.0, 1)).is_ok());
     // Distances that overflow give no bandwidth rather than a silent NaN.
     let huge: Vec<f64> = pts.iter().flatten().map(|x| 1e300 * x).collect();
     let mls = ManifoldMls::new(
