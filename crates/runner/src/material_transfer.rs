@@ -22,14 +22,9 @@ pub(crate) fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
 ) -> Result<RunReport> {
     // One transfer type for the eight kinds: the scheme is chosen at run time, so the
     // step is compiled once per kernel and material table, not once per scheme as well
-    // (`AnyTransfer`: the row sums where a branch per node would cost are compiled per
-    // scheme inside the engine).
+    // (`AnyTransfer`; the loops where a branch on the scheme would cost are compiled per
+    // shape inside the engine). α was checked with the scene's header.
     let t = &ctx.scene.spec.transfer;
-    if !(0.0..=1.0).contains(&t.alpha) {
-        return Err(ctx
-            .scene
-            .value_error("transfer.alpha", format!("{} is not in [0, 1]", t.alpha)));
-    }
     let alpha = t.alpha;
     let transfer = match t.kind {
         TransferKind::Pic => AnyTransfer::Pic,

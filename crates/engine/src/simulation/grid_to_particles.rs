@@ -34,7 +34,7 @@ struct GridVelocities<'a, const D: usize> {
 }
 
 /// A particle's G2P sums over its stencil.
-struct GatherSums<'a, const D: usize, T> {
+struct GatherSums<'a, const D: usize> {
     grid: &'a GridVelocities<'a, D>,
     /// Whether D_p is summed here (a kernel whose D_p varies, not stored with the
     /// stencil).
@@ -48,10 +48,9 @@ struct GatherSums<'a, const D: usize, T> {
     /// The quadratic modes' sums (`None` unless the transfer has them, so that the other
     /// transfers do not carry them through the stencil's loop).
     modes: Option<ModeSums<D>>,
-    transfer: std::marker::PhantomData<T>,
 }
 
-impl<const D: usize, T> GatherSums<'_, D, T> {
+impl<const D: usize> GatherSums<'_, D> {
     /// One entry's share of the sums, compiled for a transfer that reads the FLIP
     /// increment (`FLIP`) or not, and takes ∇v from C_p (`FUSED`) or sums it.
     #[inline(always)]
@@ -87,12 +86,12 @@ impl<const D: usize, T> GatherSums<'_, D, T> {
 
 /// [`GatherSums`] with the transfer's flags as constants, so the stencil's loop has no
 /// branch on them.
-struct Specialised<'s, 'g, const D: usize, T, const FLIP: bool, const FUSED: bool>(
-    &'s mut GatherSums<'g, D, T>,
+struct Specialised<'s, 'g, const D: usize, const FLIP: bool, const FUSED: bool>(
+    &'s mut GatherSums<'g, D>,
 );
 
-impl<const D: usize, T, const FLIP: bool, const FUSED: bool> EntrySink<D>
-    for Specialised<'_, '_, D, T, FLIP, FUSED>
+impl<const D: usize, const FLIP: bool, const FUSED: bool> EntrySink<D>
+    for Specialised<'_, '_, D, FLIP, FUSED>
 {
     #[inline(always)]
     fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, r: &SVector<f64, D>) {
@@ -121,7 +120,7 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme, const FLIP: bool, con
     let moment_scale = kernel.constant_second_moment();
     let offsets = shape.affine && (shape.uses_moments || moment_scale.is_none());
     let stored_moment = stencils.stored_second_moment(p);
-    let new_sums = || GatherSums::<D, T> {
+    let new_sums = || GatherSums::<D> {
         grid,
         sum_moment: moment_scale.is_none() && stored_moment.is_none(),
         offsets,
@@ -135,7 +134,6 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme, const FLIP: bool, con
             (None, None) => SMatrix::zeros(),
         },
         modes: shape.quadratic.then(ModeSums::default),
-        transfer: std::marker::PhantomData,
     };
     // A tensor-product stencil that is not stored is summed row by row, where D_p is
     // constant or unused. Stored entries get sums of their own, which no kernel call
@@ -180,12 +178,12 @@ fn gather<const D: usize, K: Kernel<D>, T: TransferScheme, const FLIP: bool, con
         }
     } else if stencils.stores_entries() {
         let mut sums = new_sums();
-        let sink = &mut Specialised::<_, _, FLIP, FUSED>(&mut sums);
+        let sink = &mut Specialised::<_, FLIP, FUSED>(&mut sums);
         stencils.visit_entries(p, kernel, &x, offsets, sink);
         sums
     } else {
         let mut sums = new_sums();
-        let sink = &mut Specialised::<_, _, FLIP, FUSED>(&mut sums);
+        let sink = &mut Specialised::<_, FLIP, FUSED>(&mut sums);
         stencils.visit(p, kernel, &x, cache, scratch, offsets, sink)?;
         sums
     };

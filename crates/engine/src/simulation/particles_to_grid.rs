@@ -71,7 +71,7 @@ fn field_limit(now: f64, moment: f64) -> f64 {
 /// kernel has an integration correction: a constant, so that the kernels without one
 /// (B-splines, whose visits are inlined here) keep an entry free of its branch. `A` is
 /// 0 for a kernel whose values are never negative (no |N|-mass summed), else 1.
-struct ScatterEntry<'w, const D: usize, T, const CORRECTED: bool, const A: usize> {
+struct ScatterEntry<'w, const D: usize, const CORRECTED: bool, const A: usize> {
     window: &'w mut Window<D>,
     /// What the particle spreads (the affine matrix zero without an affine transfer).
     load: ParticleLoad<D>,
@@ -84,12 +84,9 @@ struct ScatterEntry<'w, const D: usize, T, const CORRECTED: bool, const A: usize
     /// The particle's quadratic modes and their frame at its position (`None` unless
     /// the transfer has them and the stencil admits them).
     modes: Option<(ModeFrame<D>, QuadraticModes<D>)>,
-    transfer: std::marker::PhantomData<T>,
 }
 
-impl<const D: usize, T: TransferScheme, const CORRECTED: bool, const A: usize>
-    ScatterEntry<'_, D, T, CORRECTED, A>
-{
+impl<const D: usize, const CORRECTED: bool, const A: usize> ScatterEntry<'_, D, CORRECTED, A> {
     /// One entry's share, compiled for a transfer that spreads C_p (`AFFINE`) or not,
     /// and folds the force into the momentum (`FUSED`) or not.
     #[inline(always)]
@@ -141,21 +138,14 @@ struct Specialised<
     's,
     'w,
     const D: usize,
-    T: TransferScheme,
     const CORRECTED: bool,
     const A: usize,
     const AFFINE: bool,
     const FUSED: bool,
->(&'s mut ScatterEntry<'w, D, T, CORRECTED, A>);
+>(&'s mut ScatterEntry<'w, D, CORRECTED, A>);
 
-impl<
-    const D: usize,
-    T: TransferScheme,
-    const CORRECTED: bool,
-    const A: usize,
-    const AFFINE: bool,
-    const FUSED: bool,
-> EntrySink<D> for Specialised<'_, '_, D, T, CORRECTED, A, AFFINE, FUSED>
+impl<const D: usize, const CORRECTED: bool, const A: usize, const AFFINE: bool, const FUSED: bool>
+    EntrySink<D> for Specialised<'_, '_, D, CORRECTED, A, AFFINE, FUSED>
 {
     #[inline(always)]
     fn entry(&mut self, node: u32, n: f64, gradient: &SVector<f64, D>, r: &SVector<f64, D>) {
@@ -169,21 +159,20 @@ macro_rules! specialised {
     ($shape:expr, $entry:expr, $sink:ident => $visit:expr) => {
         match ($shape.affine, $shape.fused_force) {
             (false, false) => {
-                let $sink = &mut Specialised::<_, _, _, _, false, false>($entry);
+                let $sink = &mut Specialised::<_, _, _, false, false>($entry);
                 $visit
             }
             (true, false) => {
-                let $sink = &mut Specialised::<_, _, _, _, true, false>($entry);
+                let $sink = &mut Specialised::<_, _, _, true, false>($entry);
                 $visit
             }
-            (affine, true) => {
-                if affine {
-                    let $sink = &mut Specialised::<_, _, _, _, true, true>($entry);
-                    $visit
-                } else {
-                    let $sink = &mut Specialised::<_, _, _, _, false, true>($entry);
-                    $visit
-                }
+            (true, true) => {
+                let $sink = &mut Specialised::<_, _, _, true, true>($entry);
+                $visit
+            }
+            (false, true) => {
+                let $sink = &mut Specialised::<_, _, _, false, true>($entry);
+                $visit
             }
         }
     };
@@ -200,11 +189,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // MLS-MPM's gradient is D_p⁻¹ N_i r_i, not the kernel's, so the kernel's
         // correction of its gradient does not apply.
         let corrected = self.kernel.force_gradient_correction().filter(|_| !fused);
-        // The corrected P2G is compiled only for kernel types that may correct.
-        match (
-            K::MAY_CORRECT_FORCE_GRADIENTS && corrected.is_some(),
-            nonnegative,
-        ) {
+        // The corrected P2G is compiled only for kernel types that may correct (the
+        // guards are constants after monomorphization).
+        match (corrected.is_some(), nonnegative) {
             (true, false) if K::MAY_CORRECT_FORCE_GRADIENTS => self.scatter_particles::<true, 1>(),
             (true, true) if K::MAY_CORRECT_FORCE_GRADIENTS => self.scatter_particles::<true, 0>(),
             (_, false) => self.scatter_particles::<false, 1>(),
@@ -264,7 +251,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     let stress_volume = stresses[i] * volume;
                     let acceleration =
                         gravity + body.get(i).copied().unwrap_or_else(SVector::zeros);
-                    let mut sink = ScatterEntry::<D, T, CORRECTED, A> {
+                    let mut sink = ScatterEntry::<D, CORRECTED, A> {
                         window,
                         load: ParticleLoad {
                             mass: m,
@@ -277,7 +264,6 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                         correction: correction.unwrap_or(&[]),
                         correction_mean: SVector::zeros(),
                         modes: None,
-                        transfer: std::marker::PhantomData::<T>,
                     };
                     let stored_moment = stencils.stored_second_moment(i);
                     // The limiter and the correction's ξ̄_p read the whole stencil before

@@ -116,13 +116,8 @@ pub(super) fn scatter_rows_for<const D: usize, const W: usize>(
     load: &ParticleLoad<D>,
 ) {
     match (shape.affine, shape.fused_force) {
-        (affine, true) => {
-            if affine {
-                scatter_rows::<D, W, true, true>(t, window, load)
-            } else {
-                scatter_rows::<D, W, false, true>(t, window, load)
-            }
-        }
+        (true, true) => scatter_rows::<D, W, true, true>(t, window, load),
+        (false, true) => scatter_rows::<D, W, false, true>(t, window, load),
         (true, false) => scatter_rows::<D, W, true, false>(t, window, load),
         (false, false) => scatter_rows::<D, W, false, false>(t, window, load),
     }

@@ -97,8 +97,6 @@ pub(crate) fn to_mesh<const D: usize>(
     let mut new_index = vec![u32::MAX; raw.nodes.len()];
     let mut vertices = Vec::new();
     let mut vertex_tags = Vec::new();
-    // The raw node behind each vertex, for messages.
-    let mut vertex_node = Vec::new();
     let extent = raw
         .nodes
         .iter()
@@ -122,10 +120,9 @@ pub(crate) fn to_mesh<const D: usize>(
         new_index[i] = vertices.len() as u32;
         vertices.push(SVector::<f64, D>::from_fn(|k, _| x[k]));
         vertex_tags.push(*tag);
-        vertex_node.push(i);
     }
     if let Some((first, second)) = first_coincident(&vertices, COINCIDENCE_TOLERANCE * extent) {
-        let (_, x, at) = &raw.nodes[vertex_node[second]];
+        let (_, x, at) = &raw.nodes[node_index[&vertex_tags[second]]];
         return Err(IoError::CoincidentNodes {
             at: *at,
             first: vertex_tags[first],
