@@ -8,41 +8,45 @@
 //!   facets: a staircase with linear FE, smooth with UMLS;
 //! - `history_umls.csv`, `history_linear_fe.csv`: step, time, energies, momentum.
 //!
-//! Setup: unit square meshed with 20 × 20 jittered cells (800 triangles), disks of
-//! radius 0.2 at (0.2, 0.2) and (0.8, 0.8) moving at ±(0.1, 0.1), linear elastic
-//! E = 1000, ν = 0.3, ρ = 1000, 4 particles per 0.05² cell, FLIP 0.99, Δt = 10⁻³, T = 3.
+//! The scene is the built-in `colliding-disks` (scenes/colliding-disks.toml), set up by
+//! the runner ([`umls::runner::prepare`]) and stepped here: unit square meshed with
+//! 20 × 20 jittered cells (800 triangles), disks of radius 0.2 at (0.2, 0.2) and
+//! (0.8, 0.8) moving at ±(0.1, 0.1), linear elastic E = 1000, ν = 0.3, ρ = 1000, 4
+//! particles per 0.05² cell, FLIP 0.99, Δt = 10⁻³, T = 3.
 
 use nalgebra::Vector2;
 use std::error::Error;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use umls::constitutive::LinearElastic;
-use umls::engine::{Diagnostics, Flip, Simulation};
+use umls::engine::Diagnostics;
 use umls::io::chart::{Axis, LineChart, Series};
-use umls::kernels::{LinearFeKernel, Umls2};
-use umls::scenes::colliding_disks::CollidingDisks;
-use umls::transfer::Kernel;
+use umls::runner::schema::KernelKind;
+use umls::runner::{RunOptions, Scene, prepare};
 
 /// Energy history every 10 steps and the mean-stress history of one particle.
 struct Run {
     history: Vec<Diagnostics<2>>,
     tracer: Vec<(f64, f64)>,
     wall: f64,
+    particles: usize,
+    steps: usize,
 }
 
-fn run<K: Kernel<2>>(
-    scene: &CollidingDisks,
-    kernel: K,
-    tracer: usize,
-) -> Result<Run, Box<dyn Error>> {
-    let mut sim = scene.simulation(kernel, Flip { alpha: 0.99 })?;
+fn run(scene: &Scene, kernel: KernelKind, tracer: usize) -> Result<Run, Box<dyn Error>> {
+    let options = RunOptions {
+        kernel: Some(kernel),
+        ..RunOptions::default()
+    };
+    let mut prepared = prepare::<2>(scene, &options)?;
+    let end_time = prepared.end_time();
+    let sim = prepared.simulation();
     let start = std::time::Instant::now();
     let mut history = vec![sim.diagnostics()?];
     let mut trace = Vec::new();
-    while sim.time() < scene.end_time - 1e-9 {
-        sim.step()?;
-        let tau = sim.material_stress(tracer)?;
-        trace.push((sim.time(), 0.5 * tau.trace()));
+    while !sim.reached(end_time) {
+        sim.step_until(end_time)?;
+        let sigma = sim.cauchy_stresses()?[tracer];
+        trace.push((sim.time(), 0.5 * sigma.trace()));
         if sim.step_count() % 10 == 0 {
             history.push(sim.diagnostics()?);
         }
@@ -51,21 +55,9 @@ fn run<K: Kernel<2>>(
         history,
         tracer: trace,
         wall: start.elapsed().as_secs_f64(),
+        particles: sim.positions().len(),
+        steps: sim.step_count(),
     })
-}
-
-/// Helper trait: one particle's Kirchhoff stress without computing all of them.
-trait OneStress {
-    fn material_stress(&self, particle: usize) -> Result<nalgebra::Matrix2<f64>, Box<dyn Error>>;
-}
-
-impl<K: Kernel<2>> OneStress for Simulation<2, K, LinearElastic, Flip> {
-    fn material_stress(&self, particle: usize) -> Result<nalgebra::Matrix2<f64>, Box<dyn Error>> {
-        use umls::constitutive::Constitutive;
-        Ok(self
-            .material()
-            .kirchhoff_stress(&self.particles().deformation[particle], &())?)
-    }
 }
 
 fn csv(path: &Path, history: &[Diagnostics<2>]) -> Result<(), Box<dyn Error>> {
@@ -104,27 +96,25 @@ fn main() -> Result<(), Box<dyn Error>> {
             .unwrap_or_else(|| "out/kernel-comparison".into()),
     );
     std::fs::create_dir_all(&out)?;
-    let scene = CollidingDisks::default();
-    let mesh = scene.shared_mesh()?;
+    let scene = Scene::load("colliding-disks")?;
     // The particle nearest the contact point of the first disk: it crosses facets while
     // carrying the largest stresses.
-    let particles = scene.particles::<()>();
-    let tracer = (0..particles.len() / 2)
+    let mut probe = prepare::<2>(&scene, &RunOptions::default())?;
+    let positions = probe.simulation().positions().to_vec();
+    let tracer = (0..positions.len() / 2)
         .min_by(|&a, &b| {
-            (particles.position[a] - Vector2::new(0.33, 0.33))
+            (positions[a] - Vector2::new(0.33, 0.33))
                 .norm()
-                .total_cmp(&(particles.position[b] - Vector2::new(0.33, 0.33)).norm())
+                .total_cmp(&(positions[b] - Vector2::new(0.33, 0.33)).norm())
         })
         .ok_or("no particles")?;
+    let (dt, end_time) = (probe.simulation().settings().dt, probe.end_time());
     println!(
-        "colliding disks: {} particles, {} triangles, Δt = {}, T = {}",
-        particles.len(),
-        mesh.simplex_count(),
-        scene.dt,
-        scene.end_time
+        "colliding disks: {} particles, Δt = {dt}, T = {end_time}",
+        positions.len()
     );
-    let umls = run(&scene, Umls2::new(mesh.clone()), tracer)?;
-    let fe = run(&scene, LinearFeKernel::new(mesh), tracer)?;
+    let umls = run(&scene, KernelKind::Umls, tracer)?;
+    let fe = run(&scene, KernelKind::LinearFe, tracer)?;
     let k0 = umls.history[0].kinetic;
     println!("\n  time   UMLS kinetic  strain   total  | linear FE kinetic  strain   total");
     for (a, b) in umls.history.iter().zip(&fe.history).step_by(25) {
@@ -156,11 +146,10 @@ fn main() -> Result<(), Box<dyn Error>> {
         "stress roughness of the traced particle: UMLS {ru:.2e}, linear FE {rf:.2e} ({:.0}× rougher)",
         rf / ru
     );
-    let steps = (scene.end_time / scene.dt).round();
     println!(
         "wall time: UMLS {:.2} s ({:.2e} particle-steps/s), linear FE {:.2} s",
         umls.wall,
-        steps * particles.len() as f64 / umls.wall,
+        (umls.steps * umls.particles) as f64 / umls.wall,
         fe.wall
     );
 
@@ -209,7 +198,7 @@ fn plot_stress(path: &Path, umls: &[(f64, f64)], fe: &[(f64, f64)]) -> Result<()
     LineChart {
         title: "Mean stress of one particle crossing facets: cell-crossing noise".into(),
         x: Axis::linear("time t [s]"),
-        y: Axis::linear("mean Kirchhoff stress tr τ / 2 [Pa]"),
+        y: Axis::linear("mean Cauchy stress tr σ / 2 [Pa]"),
         series: vec![
             Series::new("linear FE", fe.to_vec()),
             Series::new("UMLS", umls.to_vec()),

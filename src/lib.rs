@@ -18,7 +18,6 @@
 //!   port alone;
 //! - [`runner`] (`umls-runner`): scenes as a library: the scene format, the built-in
 //!   scenes and the runner that steps any kernel through them ([`runner::run_with`]);
-//! - [`scenes`] (`umls-scenes`): the benchmark scenes with their references;
 //! - [`io`] (`umls-io`): Gmsh mesh reading, VTK (`.vtu`, `.pvd`) and CSV writing.
 //!
 //! The `umls` command line is the separate `umls-cli` crate (`crates/cli`).
@@ -43,6 +42,5 @@ pub use umls_manifold as manifold;
 pub use umls_mesh as mesh;
 pub use umls_mls as mls;
 pub use umls_runner as runner;
-pub use umls_scenes as scenes;
 pub use umls_transfer as transfer;
 pub use umls_ugimp as ugimp;

@@ -16,14 +16,7 @@ const RINGS: [&[&str]; 4] = [
     // Ports and wiring.
     &["umls-transfer", "umls-kernels", "umls-ugimp", "umls-engine"],
     // Adapters.
-    &[
-        "umls-scenes",
-        "umls-io",
-        "umls-runner",
-        "umls-report",
-        "umls-cli",
-        "xtask",
-    ],
+    &["umls-io", "umls-runner", "umls-report", "umls-cli", "xtask"],
     // The facade.
     &["umls"],
 ];

@@ -54,6 +54,7 @@
 
 mod boundary;
 mod diagnostics;
+mod dyn_simulation;
 mod error;
 mod face_clamp;
 mod fitted_clamp;
@@ -68,11 +69,13 @@ mod seeding;
 mod settings;
 mod simulation;
 mod stencils;
+mod time_plan;
 mod timing;
 mod transfer;
 
 pub use boundary::{Boundary, Reaction, Wall, WallKind};
 pub use diagnostics::Diagnostics;
+pub use dyn_simulation::DynSimulation;
 pub use error::EngineError;
 pub use face_clamp::{FACE_CLAMP_PENALTY, FACE_CLAMP_REGULARISATION, FaceClamp, face_points};
 pub use fitted_clamp::{FITTED_CLAMP_REGULARISATION, FittedClamp};
@@ -82,6 +85,7 @@ pub use quadratic_modes::{MAX_QUADRATIC_MODES, QUADRATIC_RIDGE, QuadraticModes};
 pub use seeding::{Inside, Region, lattice_points, lattice_samples};
 pub use settings::{Damping, MassMatrix, StencilStorage, StepSettings, TimeStepControl};
 pub use simulation::{BodyForce, Simulation};
+pub use time_plan::{MAX_PLANNED_STEPS, TimePlan};
 pub use timing::StageTimes;
 pub use transfer::{
     AnyTransfer, Apic, ApicFlip, Flip, MlsMpm, Pic, QuadraticApic, QuadraticApicFlip,

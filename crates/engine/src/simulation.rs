@@ -539,19 +539,27 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
     /// [`StepSettings::particle_sort_interval`] says so). An error names a particle by
     /// its index at construction ([`Self::particle_id`]).
     pub fn step(&mut self) -> Result<(), EngineError> {
+        self.step_until(f64::INFINITY)
+    }
+
+    /// One step toward `end_time`: [`Self::step`], with an adaptive Δt
+    /// ([`TimeStepControl::Adaptive`]) shortened so that it does not pass `end_time`. A
+    /// fixed Δt is taken as it is: [`Self::plan_until`] sets it to land on the end time.
+    pub fn step_until(&mut self, end_time: f64) -> Result<(), EngineError> {
         if self.sort_due() {
             let mut clock = Lap::start();
             self.sort_particles();
             self.times.stencils += clock.lap();
         }
-        self.advance()
+        self.advance(end_time - self.time)
             .map_err(|e| e.naming_particle_by(|slot| self.particle_id(slot)))
     }
 
     /// [`Self::step`] without the sort, naming particles by their slots (compiled into
     /// `step`, as the stages were before the sort wrapped them).
+    /// `remaining` caps an adaptive Δt (the time left to an end time).
     #[inline(always)]
-    fn advance(&mut self) -> Result<(), EngineError> {
+    fn advance(&mut self, remaining: f64) -> Result<(), EngineError> {
         let step = self.step;
         // The kernel and settings are public fields: a combination the transfer cannot
         // work with may have been set since construction.
@@ -570,14 +578,13 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
             self.totals.energy_supplied = start.total_energy();
             (self.totals.max_speed, self.totals.min_density) = self.speed_and_density();
         }
-        let dt = match self.settings.time_step {
-            TimeStepControl::Fixed => self.settings.dt,
-            TimeStepControl::Adaptive { cfl } => self.settings.dt.min(self.stable_step_from(
-                cfl,
-                self.totals.max_speed,
-                self.totals.min_density,
-            )),
-        };
+        let dt =
+            match self.settings.time_step {
+                TimeStepControl::Fixed => self.settings.dt,
+                TimeStepControl::Adaptive { cfl } => self.settings.dt.min(remaining).min(
+                    self.stable_step_from(cfl, self.totals.max_speed, self.totals.min_density),
+                ),
+            };
         self.dt = dt;
         // The stability limit with the speeds and densities the step starts from (those
         // an adaptive step is sized by, so a cfl ≤ 1 never trips it).

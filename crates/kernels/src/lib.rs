@@ -13,6 +13,10 @@
 //!   which it also hands over as per-axis factors (`Kernel::tensor_stencil`) for
 //!   transfers that sum them row by row.
 //!
+//! [`presets`] names the built-in kernels (`umls` and its variants, `linear-fe`,
+//! `bspline2`, `bspline3`) with their settings and, per dimension, their types: what
+//! scene files and the command line select (feature `mesh`).
+//!
 //! Every kernel passes the same conformance suite (`testing::check_kernel`, public with
 //! the feature `testing` so that a kernel written elsewhere can run it too): partition
 //! of unity, linear reproduction of values and gradients, the declared second moment,
@@ -42,6 +46,8 @@ mod bspline;
 mod integration_correction;
 #[cfg(feature = "mesh")]
 mod mesh_kernels;
+#[cfg(feature = "mesh")]
+pub mod presets;
 
 #[cfg(feature = "testing")]
 pub mod testing;

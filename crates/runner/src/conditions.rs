@@ -45,7 +45,7 @@ pub(crate) fn apply_boundaries<const D: usize>(
             }
         };
         // Each condition's nodes are a reaction set, so its force is reported.
-        sim.boundary().reaction_sets.push(nodes);
+        sim.boundary_mut().reaction_sets.push(nodes);
     }
     Ok(())
 }
@@ -85,8 +85,11 @@ fn hold<const D: usize>(
     nodes: &[(u32, SVector<f64, D>)],
 ) {
     match kind {
-        BoundaryKind::Fixed => sim.boundary().fixed.extend(nodes.iter().map(|(n, _)| *n)),
-        BoundaryKind::Slip => sim.boundary().slip.extend(nodes.iter().copied()),
+        BoundaryKind::Fixed => sim
+            .boundary_mut()
+            .fixed
+            .extend(nodes.iter().map(|(n, _)| *n)),
+        BoundaryKind::Slip => sim.boundary_mut().slip.extend(nodes.iter().copied()),
     }
 }
 
@@ -179,10 +182,13 @@ impl<const D: usize> HeldRegion<'_, D> {
                 }
                 let mut clamp = FittedClamp::new(nodes.clone(), particles);
                 clamp.reach = sim.spacing();
-                sim.boundary().fitted.push(clamp);
+                sim.boundary_mut().fitted.push(clamp);
             }
-            None => sim.boundary().fixed.extend(nodes.iter().copied()),
-            Some(n) => sim.boundary().slip.extend(nodes.iter().map(|&v| (v, *n))),
+            None => sim.boundary_mut().fixed.extend(nodes.iter().copied()),
+            Some(n) => sim
+                .boundary_mut()
+                .slip
+                .extend(nodes.iter().map(|&v| (v, *n))),
         }
         Ok(nodes)
     }

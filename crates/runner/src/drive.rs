@@ -18,13 +18,7 @@ pub(crate) fn drive<const D: usize>(
     ctx: &Context<'_, D>,
     sim: &mut dyn Run<D>,
 ) -> Result<RunReport> {
-    let setup = &ctx.setup;
-    if let Some(k0) = setup.geostatic_k0 {
-        sim.set_geostatic_stress(k0)?;
-    }
-    let mut warnings = setup.warnings.clone();
-    let plan = plan_time_step(ctx, sim, &mut warnings)?;
-    conditions::apply_boundaries(ctx, sim)?;
+    let (plan, mut warnings) = prologue(ctx, sim)?;
     let mut out = OutputDir::create(ctx.options.out.as_deref(), ctx.encoding)?;
     let mut recorder = Recorder::new(ctx, sim, &out)?;
     sim.write_particles(&mut out, recorder.reference_positions())?;
@@ -77,6 +71,21 @@ pub(crate) fn drive<const D: usize>(
     }
 }
 
+/// What a run does before its first step: the geostatic stress, the time step planned to
+/// the end time, the boundaries; the plan and the set-up's and the plan's warnings.
+pub(crate) fn prologue<const D: usize>(
+    ctx: &Context<'_, D>,
+    sim: &mut dyn Run<D>,
+) -> Result<(TimePlan, Vec<String>)> {
+    if let Some(k0) = ctx.setup.geostatic_k0 {
+        sim.set_geostatic_stress(k0)?;
+    }
+    let mut warnings = ctx.setup.warnings.clone();
+    let plan = plan_time_step(ctx, sim, &mut warnings)?;
+    conditions::apply_boundaries(ctx, sim)?;
+    Ok((plan, warnings))
+}
+
 /// Steps until the end time; the error that stopped the run early, if any.
 fn step_to_end<const D: usize>(
     ctx: &Context<'_, D>,
@@ -91,11 +100,8 @@ fn step_to_end<const D: usize>(
     let mut next_frame = 1;
     let mut step = 0;
     let end = ctx.end_time * (1.0 - 1e-12);
-    while sim.time() < end {
+    while !sim.reached(ctx.end_time) {
         step += 1;
-        if let umls_engine::TimeStepControl::Adaptive { .. } = sim.settings().time_step {
-            sim.settings_mut().dt = plan.dt_cap.min(ctx.end_time - sim.time());
-        }
         if ctx
             .options
             .interrupt
@@ -107,17 +113,23 @@ fn step_to_end<const D: usize>(
                 step: sim.step_count(),
             });
         }
+        // The longest this step may be: an adaptive one stops at the end time.
+        let dt = match sim.settings().time_step {
+            umls_engine::TimeStepControl::Adaptive { .. } => {
+                plan.dt_cap.min(ctx.end_time - sim.time())
+            }
+            umls_engine::TimeStepControl::Fixed => sim.settings().dt,
+        };
         // Reactions are summed only for the steps whose history row reads them (the last
         // step is predicted with half a step of margin).
-        let dt = sim.settings().dt;
         sim.settings_mut().measure_reactions =
             step % history_every == 0 || sim.time() + 1.5 * dt >= end;
-        sim.step()?;
+        sim.step_until(ctx.end_time)?;
         recorder.after_step(sim)?;
         if step % history_every == 0 || sim.time() >= end {
             recorder.record(sim)?;
         }
-        if next_frame < frames && sim.time() >= frame_time(next_frame) - 0.5 * sim.settings().dt {
+        if next_frame < frames && sim.time() >= frame_time(next_frame) - 0.5 * dt {
             sim.write_particles(out, recorder.reference_positions())?;
             next_frame += 1;
         }

@@ -10,18 +10,18 @@
 
 use std::sync::Arc;
 
+use umls_kernels::presets::{Preset, PresetFamily, UmlsPreset};
 use umls_kernels::{BSplineKernel, BSplineOrder, GradientKind, LinearFeKernel, UmlsMeshKernel};
 use umls_mesh::SimplexMesh;
 use umls_mls::{
-    DEFAULT_SHARPENING, DEFAULT_SUPPORT_FACTOR, Linear, Profile, Quadratic, SharpenedBSpline,
-    SupportRadius, UmlsKernel,
+    DEFAULT_SHARPENING, MlsError, Profile, SharpenedBSpline, SupportRadius, UmlsKernel,
 };
 use umls_transfer::Kernel;
 use umls_ugimp::{UgimpError, UgimpKernel};
 
 use crate::error::Result;
 use crate::scene::Scene;
-use crate::schema::{GradientSpec, KernelKind, SupportSpec, WeightSpec};
+use crate::schema::{KernelKind, SupportSpec, WeightSpec};
 use crate::setup::Setup;
 
 /// Builds a kernel for a scene's set-up: the door through which a kernel type enters
@@ -29,7 +29,7 @@ use crate::setup::Setup;
 /// of a researcher's own; [`crate::run_with`] runs a scene with it.
 pub trait KernelFactory<const D: usize> {
     /// The kernel type the runs step with.
-    type Kernel: Kernel<D>;
+    type Kernel: Kernel<D> + 'static;
 
     /// The kernel's name in the summary, the history's plot titles and the report.
     fn name(&self) -> String;
@@ -47,12 +47,12 @@ pub trait KernelFactory<const D: usize> {
 
 /// A built-in kernel of `[kernel] kind`, with the UMLS kernel type of its dimension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Preset<U> {
+pub struct BuiltIn<U> {
     kind: KernelKind,
     umls: std::marker::PhantomData<U>,
 }
 
-impl<U> Preset<U> {
+impl<U> BuiltIn<U> {
     /// The preset of `kind`.
     pub fn new(kind: KernelKind) -> Self {
         Self {
@@ -79,17 +79,17 @@ fn umls<const D: usize, U: FromMls<D>>(
     kind: KernelKind,
 ) -> Result<U> {
     let mesh = mesh(scene, setup)?;
-    let mls = umls_settings(scene, kind, &mesh)?;
-    corrected(scene, kind, U::from_mls(mesh, mls))
+    let settings = umls_settings(scene, kind)?;
+    let mls = mls_kernel(scene, &settings, &mesh)?;
+    corrected(
+        scene,
+        &settings,
+        U::from_mls(mesh, (mls, settings.gradient)),
+    )
 }
 
-/// The UMLS presets with the linear basis.
-pub type LinearUmls<const D: usize, const N: usize> = UmlsMeshKernel<D, N, Linear, Profile>;
-/// `umls-quadratic`.
-pub type QuadraticUmls<const D: usize, const N: usize> = UmlsMeshKernel<D, N, Quadratic, Profile>;
-
 impl<const D: usize, const N: usize, B> KernelFactory<D>
-    for Preset<UmlsMeshKernel<D, N, B, Profile>>
+    for BuiltIn<UmlsMeshKernel<D, N, B, Profile>>
 where
     B: umls_mls::PolynomialBasis<D, N>,
     UmlsMeshKernel<D, N, B, Profile>: Kernel<D>,
@@ -106,7 +106,7 @@ where
     }
 }
 
-impl<const D: usize> KernelFactory<D> for Preset<LinearFeKernel<D>>
+impl<const D: usize> KernelFactory<D> for BuiltIn<LinearFeKernel<D>>
 where
     LinearFeKernel<D>: Kernel<D>,
 {
@@ -122,7 +122,7 @@ where
     }
 }
 
-impl<const D: usize> KernelFactory<D> for Preset<UgimpKernel<D>> {
+impl<const D: usize> KernelFactory<D> for BuiltIn<UgimpKernel<D>> {
     type Kernel = UgimpKernel<D>;
     fn name(&self) -> String {
         self.kind.name().to_string()
@@ -135,7 +135,7 @@ impl<const D: usize> KernelFactory<D> for Preset<UgimpKernel<D>> {
     }
 }
 
-impl<const D: usize> KernelFactory<D> for Preset<BSplineKernel<D>> {
+impl<const D: usize> KernelFactory<D> for BuiltIn<BSplineKernel<D>> {
     type Kernel = BSplineKernel<D>;
     fn name(&self) -> String {
         self.kind.name().to_string()
@@ -144,10 +144,9 @@ impl<const D: usize> KernelFactory<D> for Preset<BSplineKernel<D>> {
         false
     }
     fn build(&self, scene: &Scene, setup: &Setup<D>) -> Result<Self::Kernel> {
-        let order = if self.kind == KernelKind::Bspline3 {
-            BSplineOrder::Cubic
-        } else {
-            BSplineOrder::Quadratic
+        let order = match self.kind.preset().map(Preset::family) {
+            Some(PresetFamily::BSpline(order)) => order,
+            _ => return Err(scene.value_error("kernel.kind", "is not a B-spline kernel")),
         };
         bspline(scene, setup, order)
     }
@@ -181,18 +180,14 @@ impl<const D: usize, const N: usize, B: umls_mls::PolynomialBasis<D, N>> FromMls
     }
 }
 
-/// The UMLS kernel with its force's integration correction where `[kernel]
-/// integration_correction` (or the kernel name's preset, [`umls_preset`]) asks for it.
+/// The UMLS kernel with its force's integration correction where the settings (the
+/// preset's, or `[kernel] integration_correction`) ask for it.
 fn corrected<const D: usize, K: FromMls<D>>(
     scene: &Scene,
-    kind: KernelKind,
+    settings: &UmlsPreset,
     kernel: K,
 ) -> Result<K> {
-    let spec = &scene.spec.kernel;
-    if !spec
-        .integration_correction
-        .unwrap_or(umls_preset(kind).corrected)
-    {
+    if !settings.integration_correction {
         return Ok(kernel);
     }
     kernel
@@ -200,139 +195,72 @@ fn corrected<const D: usize, K: FromMls<D>>(
         .map_err(|e| scene.value_error("kernel.integration_correction", e.to_string()))
 }
 
-/// The MLS settings of a UMLS kernel and its gradient kind: the kernel name's preset
-/// (profile, radius rule, factor, gradient, exponent of η), with `[kernel]`'s `weight`,
-/// `support`, `support_factor`, `gradient` and `diminishing_exponent` overriding it. The
-/// quadratic basis needs six (2D) or ten (3D) weighted samples, more than a vertex on a
-/// wall or in a corner has, so its quadratic terms carry a small ridge.
-fn umls_settings<const D: usize>(
-    scene: &Scene,
-    kind: KernelKind,
-    mesh: &SimplexMesh<D>,
-) -> Result<(UmlsKernel<D, Profile>, GradientKind)> {
+/// The settings of the UMLS preset `kind` (`umls_kernels::presets`) with `[kernel]`'s
+/// `weight`, `sharpening`, `support`, `support_factor`, `gradient`,
+/// `diminishing_exponent` and `integration_correction` overriding them.
+fn umls_settings(scene: &Scene, kind: KernelKind) -> Result<UmlsPreset> {
     let spec = &scene.spec.kernel;
-    let preset = umls_preset(kind);
-    let weight = match spec.weight.unwrap_or(preset.weight) {
-        WeightSpec::CubicBspline => Profile::CubicBSpline,
-        WeightSpec::Wendland => Profile::WendlandC2,
-        WeightSpec::Sharpened => Profile::Sharpened(
-            SharpenedBSpline::new(spec.sharpening.unwrap_or(DEFAULT_SHARPENING))
-                .map_err(|e| scene.value_error("kernel.sharpening", e.to_string()))?,
-        ),
+    let mut settings = match kind.preset().map(Preset::family) {
+        Some(PresetFamily::Umls(s) | PresetFamily::UmlsQuadratic(s)) => s,
+        _ => return Err(scene.value_error("kernel.kind", "is not a UMLS kernel")),
     };
-    let factor = spec.support_factor.unwrap_or(preset.factor);
-    let support = match spec.support.unwrap_or(preset.support) {
+    let sharpened = |epsilon: f64| {
+        SharpenedBSpline::new(epsilon)
+            .map(Profile::Sharpened)
+            .map_err(|e| scene.value_error("kernel.sharpening", e.to_string()))
+    };
+    settings.profile = match (spec.weight, settings.profile) {
+        (Some(WeightSpec::CubicBspline), _) => Profile::CubicBSpline,
+        (Some(WeightSpec::Wendland), _) => Profile::WendlandC2,
+        (Some(WeightSpec::Sharpened), _) => {
+            sharpened(spec.sharpening.unwrap_or(DEFAULT_SHARPENING))?
+        }
+        (None, Profile::Sharpened(_)) if spec.sharpening.is_some() => {
+            sharpened(spec.sharpening.unwrap_or(DEFAULT_SHARPENING))?
+        }
+        (None, profile) => profile,
+    };
+    let (rule, factor) = match settings.support {
+        SupportRadius::PerVertex { factor } => (SupportSpec::PerVertex, factor),
+        SupportRadius::IncidentEdge { factor } => (SupportSpec::IncidentEdge, factor),
+        SupportRadius::ElementSize { factor } => (SupportSpec::ElementSize, factor),
+        SupportRadius::Global { factor } => (SupportSpec::Global, factor),
+    };
+    let factor = spec.support_factor.unwrap_or(factor);
+    settings.support = match spec.support.unwrap_or(rule) {
         SupportSpec::PerVertex => SupportRadius::PerVertex { factor },
         SupportSpec::IncidentEdge => SupportRadius::IncidentEdge { factor },
         SupportSpec::ElementSize => SupportRadius::ElementSize { factor },
         SupportSpec::Global => SupportRadius::Global { factor },
     };
-    let mut mls = UmlsKernel::with_weight(mesh, weight, support)
-        .map_err(|e| scene.value_error("kernel.support_factor", e.to_string()))?
-        .with_diminishing_exponent(spec.diminishing_exponent.unwrap_or(preset.exponent))
-        .map_err(|e| scene.value_error("kernel.diminishing_exponent", e.to_string()))?;
-    if kind == KernelKind::UmlsQuadratic {
-        mls.conditioning.higher_order_ridge = QUADRATIC_RIDGE;
+    if let Some(gradient) = spec.gradient {
+        settings.gradient = gradient.kind();
     }
-    Ok((mls, spec.gradient.unwrap_or(preset.gradient).kind()))
+    if let Some(p) = spec.diminishing_exponent {
+        settings.diminishing_exponent = p;
+    }
+    if let Some(corrected) = spec.integration_correction {
+        settings.integration_correction = corrected;
+    }
+    Ok(settings)
 }
 
-/// p of `umls-eta4`'s weights η^p · d, and its support factor: the pair of the study in
-/// docs/umls-kernel.md (*Powered diminishing factor*) that keeps the vortex within 4 % of
-/// `umls` and cuts the bar scene's stall to a third.
-const ETA4_EXPONENT: u32 = 4;
-/// See [`ETA4_EXPONENT`].
-const ETA4_SUPPORT_FACTOR: f64 = 1.4;
-/// p of `umls-eta8`'s weights, and its support factor: the pair of the same study that
-/// brings the disks within 5 points of bspline2 at 20 and 40 cells, with FLIP 0.99 and
-/// with APIC.
-const ETA8_EXPONENT: u32 = 8;
-/// See [`ETA8_EXPONENT`].
-const ETA8_SUPPORT_FACTOR: f64 = 2.8;
-
-/// The element-size support factor of `umls-element-size`: the radius of the cells' own
-/// size, the narrowest of the sweep in docs/umls-kernel.md (*Element-size radii*) whose
-/// vortex completes at four particles per cell (0.9 loses a particle at 60 cells) and
-/// the widest that brings the disks within 5 points of bspline2 under both transfers.
-const ELEMENT_SIZE_SUPPORT_FACTOR: f64 = 1.0;
-
-/// Relative ridge on the quadratic monomials of `umls-quadratic`.
-const QUADRATIC_RIDGE: f64 = 1e-3;
-
-/// What a UMLS kernel name stands for; `[kernel]`'s keys override each part.
-struct UmlsPreset {
-    weight: WeightSpec,
-    support: SupportSpec,
-    factor: f64,
-    gradient: GradientSpec,
-    /// p of the weights η^p · d.
-    exponent: u32,
-    /// Whether the force's gradients carry the integration correction ([`corrected`]).
-    corrected: bool,
-}
-
-/// Profile, radius rule, factor, gradient, exponent of η and integration correction of
-/// each UMLS kernel name. `umls-eta4`, `umls-eta8` and `umls-element-size` change one
-/// part of `umls`; the other names change one part of `umls-uncorrected`, the kernel
-/// their studies measured against.
-fn umls_preset(kind: KernelKind) -> UmlsPreset {
-    let umls = UmlsPreset {
-        weight: WeightSpec::CubicBspline,
-        support: SupportSpec::IncidentEdge,
-        factor: DEFAULT_SUPPORT_FACTOR,
-        gradient: GradientSpec::Reconstructed,
-        exponent: 1,
-        corrected: true,
-    };
-    let uncorrected = UmlsPreset {
-        corrected: false,
-        ..umls
-    };
-    match kind {
-        KernelKind::Umls => umls,
-        KernelKind::UmlsWide => UmlsPreset {
-            support: SupportSpec::PerVertex,
-            factor: 1.0,
-            ..uncorrected
-        },
-        KernelKind::UmlsPaper => UmlsPreset {
-            support: SupportSpec::Global,
-            factor: 1.0,
-            ..uncorrected
-        },
-        KernelKind::UmlsWendland => UmlsPreset {
-            weight: WeightSpec::Wendland,
-            ..uncorrected
-        },
-        KernelKind::UmlsSharp => UmlsPreset {
-            weight: WeightSpec::Sharpened,
-            ..uncorrected
-        },
-        KernelKind::UmlsFullGradient => UmlsPreset {
-            gradient: GradientSpec::Full,
-            ..uncorrected
-        },
-        KernelKind::UmlsFrozenEta => UmlsPreset {
-            gradient: GradientSpec::FrozenEta,
-            ..uncorrected
-        },
-        KernelKind::UmlsEta4 => UmlsPreset {
-            factor: ETA4_SUPPORT_FACTOR,
-            exponent: ETA4_EXPONENT,
-            ..umls
-        },
-        KernelKind::UmlsEta8 => UmlsPreset {
-            factor: ETA8_SUPPORT_FACTOR,
-            exponent: ETA8_EXPONENT,
-            ..umls
-        },
-        KernelKind::UmlsElementSize => UmlsPreset {
-            support: SupportSpec::ElementSize,
-            factor: ELEMENT_SIZE_SUPPORT_FACTOR,
-            ..umls
-        },
-        _ => uncorrected,
-    }
+/// The MLS kernel of `settings` on `mesh`; an error names the scene key it comes from.
+fn mls_kernel<const D: usize>(
+    scene: &Scene,
+    settings: &UmlsPreset,
+    mesh: &SimplexMesh<D>,
+) -> Result<UmlsKernel<D, Profile>> {
+    settings.mls_kernel(mesh).map_err(|e| {
+        let key = match e {
+            MlsError::InvalidParameter {
+                parameter: "diminishing exponent",
+                ..
+            } => "kernel.diminishing_exponent",
+            _ => "kernel.support_factor",
+        };
+        scene.value_error(key, e.to_string())
+    })
 }
 
 /// Most nodes a grid may have (a typo in the spacing should be an error).

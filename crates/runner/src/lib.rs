@@ -65,7 +65,8 @@ mod time_plan;
 pub use error::{Result, RunError};
 pub use kernel_choice::KernelFactory;
 pub use run::{
-    Dim, History, Progress, RunOptions, RunPlan, RunReport, SceneDimension, run, run_with,
+    Dim, History, Prepared, Progress, RunOptions, RunPlan, RunReport, SceneDimension, WithFactory,
+    prepare, prepare_with, run, run_with,
 };
 pub use scene::Scene;
 pub use setup::Setup;

@@ -11,15 +11,18 @@ use umls_engine::{
 };
 use umls_transfer::Kernel;
 
-use crate::context::{Context, RunReport};
+use crate::context::Context;
 use crate::error::Result;
+use crate::handle::Run;
 use crate::schema::{ForcePosition, TransferKind};
 
-pub(crate) fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
+/// The simulation of `ctx`'s scene on `kernel` with the material `table` and the
+/// scene's transfer scheme, as the run loop's trait object.
+pub(crate) fn with_material<const D: usize, K: Kernel<D> + 'static, P: PlasticPart<D> + 'static>(
     ctx: &Context<'_, D>,
     kernel: K,
     table: MaterialTable<P>,
-) -> Result<RunReport> {
+) -> Result<Box<dyn Run<D>>> {
     // One transfer type for the eight kinds: the scheme is chosen at run time, so the
     // step is compiled once per kernel and material table, not once per scheme as well
     // (`AnyTransfer`; the loops where a branch on the scheme would cost are compiled per
@@ -52,12 +55,12 @@ pub(crate) fn with_material<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
 
 /// The typed part of a run: particles of the table's state and the kernel's cache, and
 /// the simulation, handed to the run loop as a [`Run`].
-fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
+fn start<const D: usize, K: Kernel<D> + 'static, P: PlasticPart<D> + 'static>(
     ctx: &Context<'_, D>,
     kernel: K,
     table: MaterialTable<P>,
     transfer: AnyTransfer,
-) -> Result<RunReport> {
+) -> Result<Box<dyn Run<D>>> {
     let seeds = &ctx.setup.seeds;
     let mut particles = Particles::<D, TableState<P::State>, K::Cache>::at_rest(
         seeds.position.clone(),
@@ -104,5 +107,5 @@ fn start<const D: usize, K: Kernel<D>, P: PlasticPart<D>>(
                 .unwrap_or_else(|_| SVector::from_element(f64::NAN))
         }));
     }
-    crate::drive::drive(ctx, &mut sim)
+    Ok(Box::new(sim))
 }

@@ -70,7 +70,7 @@ impl<'a, const D: usize> Recorder<'a, D> {
         let setup = &ctx.setup;
         let probes = Probes::new(ctx.scene, &setup.frame, &setup.seeds.position)?;
         let wall = setup.pressure.map(|(boundary, centre, area)| {
-            let sets = sim.reaction_sets();
+            let sets = sim.boundary_mut().reaction_sets.clone();
             let offset: usize = sets[..boundary].iter().map(Vec::len).sum();
             let positions = sim.node_positions();
             let nodes = sets[boundary]

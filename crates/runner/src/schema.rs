@@ -172,62 +172,41 @@ pub struct LatticeSpec {
     pub diagonal: Option<DiagonalSpec>,
 }
 
-/// Kernel names.
+/// Kernel names: the kernels' presets (`umls_kernels::presets::Preset`, whose variants
+/// say what each kernel is and which study chose it) and `ugimp`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum KernelKind {
-    /// C¹ UMLS kernel on the mesh: linear basis, cubic B-spline weights with the
-    /// incident-edge support radius, and the integration correction of its force
-    /// gradients (docs/umls-kernel.md has the studies that chose them). The other UMLS
-    /// names but `umls-eta4`, `umls-eta8` and `umls-element-size` (which vary `umls`
-    /// itself) change one part of `umls-uncorrected`, the kernel their studies measured
-    /// against; `[kernel] integration_correction = true` corrects any of them.
     #[default]
+    /// `umls`.
     Umls,
-    /// UMLS with the quadratic basis on the 1-ring (ridge on the quadratic terms).
+    /// `umls-quadratic`.
     UmlsQuadratic,
-    /// UMLS with Wendland C² distance weights.
+    /// `umls-wendland`.
     UmlsWendland,
-    /// UMLS with sharpened distance weights: the cubic B-spline divided by 1 + (r/ε)²,
-    /// ε = 0.4 (`[kernel] sharpening`), closer to interpolating its nearest vertices.
+    /// `umls-sharp`.
     UmlsSharp,
-    /// UMLS with the wide per-vertex support (each vertex's farthest stencil reach), the
-    /// default before the support study.
+    /// `umls-wide`.
     UmlsWide,
-    /// UMLS with the paper's one global radius, the mesh's longest edge.
+    /// `umls-paper`.
     UmlsPaper,
-    /// The `umls` kernel with the full derivative of the MLS fit as shape-function
-    /// gradient (divergence-consistent on unstructured tetrahedra, discontinuous across
-    /// facets) instead of the reconstructed one.
+    /// `umls-full-gradient`.
     UmlsFullGradient,
-    /// The `umls` kernel with the fit's derivative at frozen diminishing factors η as
-    /// shape-function gradient: the full derivative without ∇η's jump, so continuous
-    /// across facets (docs/umls-kernel.md, *Gradients*).
+    /// `umls-frozen-eta`.
     UmlsFrozenEta,
-    /// The `umls` kernel without the integration correction of its force gradients: the
-    /// default before the correction (docs/umls-kernel.md, *Integration correction*).
+    /// `umls-uncorrected`.
     UmlsUncorrected,
-    /// The `umls` kernel (integration correction included) with weights η⁴ · d and the
-    /// incident-edge support factor 1.4: the diminishing factor raised to a power narrows
-    /// the stencil onto the host's vertices, the wider distance weight keeps it smooth
-    /// (docs/umls-kernel.md, *Powered diminishing factor*).
+    /// `umls-eta4`.
     UmlsEta4,
-    /// The `umls` kernel with weights η⁸ · d and the incident-edge support factor 2.8:
-    /// further along the same frontier, the disks within 5 points of quadratic B-splines,
-    /// the vortex at h/2 twice the default's error (docs/umls-kernel.md).
+    /// `umls-eta8`.
     UmlsEta8,
-    /// The `umls` kernel with the element-size support radius (factor 1.0): every
-    /// vertex's radius is its cells' size, so a lattice gets one radius where the
-    /// incident-edge rule widens the vertices on diagonals and long jittered edges. The
-    /// disks within 5 points of quadratic B-splines on the scene's own lattice and the
-    /// columns closer to exact; the vortex needs nine particles per cell to converge
-    /// (docs/umls-kernel.md, *Element-size radii*).
+    /// `umls-element-size`.
     UmlsElementSize,
-    /// Linear finite-element shape functions on the mesh.
+    /// `linear-fe`.
     LinearFe,
-    /// Quadratic B-splines on a Cartesian grid covering the mesh.
+    /// `bspline2`.
     Bspline2,
-    /// Cubic B-splines on a Cartesian grid covering the mesh.
+    /// `bspline3`.
     Bspline3,
     /// uGIMP (Bardenhagen & Kober 2004) on the grid the B-splines use: the linear hat
     /// averaged over each particle's box of half its initial spacing (`umls-ugimp`).
@@ -262,24 +241,32 @@ impl KernelKind {
 
     /// The name used in scene files and on the command line.
     pub fn name(self) -> &'static str {
-        match self {
-            KernelKind::Umls => "umls",
-            KernelKind::UmlsQuadratic => "umls-quadratic",
-            KernelKind::UmlsWendland => "umls-wendland",
-            KernelKind::UmlsSharp => "umls-sharp",
-            KernelKind::UmlsWide => "umls-wide",
-            KernelKind::UmlsPaper => "umls-paper",
-            KernelKind::UmlsFullGradient => "umls-full-gradient",
-            KernelKind::UmlsFrozenEta => "umls-frozen-eta",
-            KernelKind::UmlsUncorrected => "umls-uncorrected",
-            KernelKind::UmlsEta4 => "umls-eta4",
-            KernelKind::UmlsEta8 => "umls-eta8",
-            KernelKind::UmlsElementSize => "umls-element-size",
-            KernelKind::LinearFe => "linear-fe",
-            KernelKind::Bspline2 => "bspline2",
-            KernelKind::Bspline3 => "bspline3",
-            KernelKind::Ugimp => "ugimp",
-        }
+        self.preset()
+            .map_or("ugimp", umls_kernels::presets::Preset::name)
+    }
+
+    /// The kernels' preset of this name (all but `ugimp`, whose kernel is its own
+    /// crate's).
+    pub fn preset(self) -> Option<umls_kernels::presets::Preset> {
+        use umls_kernels::presets::Preset;
+        Some(match self {
+            KernelKind::Umls => Preset::Umls,
+            KernelKind::UmlsQuadratic => Preset::UmlsQuadratic,
+            KernelKind::UmlsWendland => Preset::UmlsWendland,
+            KernelKind::UmlsSharp => Preset::UmlsSharp,
+            KernelKind::UmlsWide => Preset::UmlsWide,
+            KernelKind::UmlsPaper => Preset::UmlsPaper,
+            KernelKind::UmlsFullGradient => Preset::UmlsFullGradient,
+            KernelKind::UmlsFrozenEta => Preset::UmlsFrozenEta,
+            KernelKind::UmlsUncorrected => Preset::UmlsUncorrected,
+            KernelKind::UmlsEta4 => Preset::UmlsEta4,
+            KernelKind::UmlsEta8 => Preset::UmlsEta8,
+            KernelKind::UmlsElementSize => Preset::UmlsElementSize,
+            KernelKind::LinearFe => Preset::LinearFe,
+            KernelKind::Bspline2 => Preset::Bspline2,
+            KernelKind::Bspline3 => Preset::Bspline3,
+            KernelKind::Ugimp => return None,
+        })
     }
 }
 

@@ -1,16 +1,12 @@
 //! The time step of a run: a fixed step that lands on the end time, or the cap of the
 //! adaptive one, and the number of steps and frames planned.
 
-use umls_engine::TimeStepControl;
+use umls_engine::{EngineError, MAX_PLANNED_STEPS, TimeStepControl};
 
 use crate::context::Context;
 use crate::error::Result;
 use crate::handle::Run;
 use crate::setup;
-
-/// Most steps a run may plan: a typo in `end_time` (1e12 for 1.2) should be an error,
-/// not a run of years.
-const MAX_STEPS: f64 = 1e9;
 
 /// What the run loop steps by.
 #[derive(Debug, Clone, Copy)]
@@ -47,22 +43,27 @@ pub(crate) fn plan_time_step<const D: usize>(
         // `check_header` guarantees a time step setting.
         _ => return Err(scene.value_error("time", "give exactly one of `dt` and `cfl`")),
     };
-    let planned = ((ctx.end_time / target_dt) - 1e-9).ceil().max(1.0);
-    if planned > MAX_STEPS {
-        return Err(scene.value_error(
-            "scene.end_time",
-            format!(
-                "{} with a time step of {target_dt:.4e} is {planned:.3e} steps (limit {MAX_STEPS:.0e})",
-                ctx.end_time
-            ),
-        ));
+    if sim.settings().time_step != TimeStepControl::Fixed {
+        // The adaptive step's cap: the scene's Δt, else none below the end time.
+        sim.settings_mut().dt = spec.time.dt.unwrap_or(ctx.end_time);
     }
-    let steps = planned as usize;
-    let dt_cap = match sim.settings().time_step {
-        TimeStepControl::Adaptive { .. } => spec.time.dt.unwrap_or(ctx.end_time),
-        TimeStepControl::Fixed => ctx.end_time / steps as f64,
-    };
-    sim.settings_mut().dt = dt_cap;
+    let planned = sim
+        .plan_until(ctx.end_time, target_dt)
+        .map_err(|e| match e {
+            EngineError::InvalidParameter {
+                parameter: "steps",
+                value,
+                ..
+            } => scene.value_error(
+                "scene.end_time",
+                format!(
+                    "{} with a time step of {target_dt:.4e} is {value:.3e} steps (limit {MAX_PLANNED_STEPS:.0e})",
+                    ctx.end_time
+                ),
+            ),
+            e => e.into(),
+        })?;
+    let (steps, dt_cap) = (planned.steps, planned.dt);
     if sim.settings().time_step == TimeStepControl::Fixed && dt_cap > stable_dt {
         warnings.push(format!(
             "time.dt = {dt_cap:.4e} exceeds the stable step {stable_dt:.4e} (wave Courant number {:.3} > 1): expect the run to blow up",

@@ -1,5 +1,5 @@
 //! Scene files: the built-in ones build the same particles and give the same results as
-//! the hand-written scenes of `umls-scenes`; bad files fail naming the key.
+//! the same scenes built by hand from the engine; bad files fail naming the key.
 
 use umls_engine::Apic;
 use umls_kernels::{Umls1, Umls2};
@@ -7,8 +7,10 @@ use umls_runner::RunError;
 use umls_runner::run::{RunOptions, run};
 use umls_runner::scene::Scene;
 use umls_runner::setup::{build, segments, triangles};
-use umls_scenes::colliding_disks::CollidingDisks;
-use umls_scenes::vibrating_bar::VibratingBar;
+
+#[path = "common/by_hand.rs"]
+mod by_hand;
+use by_hand::Bar;
 
 #[path = "common/runs.rs"]
 mod runs;
@@ -27,8 +29,7 @@ fn options(name: &str, end_time: Option<f64>) -> RunOptions {
 fn disks_file_builds_the_hand_written_scene() {
     let scene = Scene::load("colliding-disks").unwrap();
     let setup = build::<2>(&scene, triangles).unwrap();
-    let reference = CollidingDisks::default();
-    let particles = reference.particles::<()>();
+    let particles = by_hand::disks_particles::<()>();
     // The same lattice points, from different origins: equal to round-off, same order.
     assert_eq!(setup.seeds.position.len(), particles.position.len());
     let offset = setup
@@ -42,22 +43,19 @@ fn disks_file_builds_the_hand_written_scene() {
     assert_eq!(setup.seeds.velocity, particles.velocity);
     assert_eq!(setup.seeds.mass, particles.mass);
     let mesh = setup.background.mesh().unwrap();
-    assert_eq!(mesh.vertices(), reference.mesh().unwrap().vertices());
-    assert_eq!(
-        mesh.connectivity(),
-        reference.mesh().unwrap().connectivity()
-    );
+    let reference = by_hand::disks_mesh();
+    assert_eq!(mesh.vertices(), reference.vertices());
+    assert_eq!(mesh.connectivity(), reference.connectivity());
 }
 
 #[test]
 fn disks_file_runs_like_the_hand_written_scene() {
     let scene = Scene::load("colliding-disks").unwrap();
     let report = run(&scene, &options("disks-file", Some(0.05))).unwrap();
-    let reference = CollidingDisks::default();
-    let mesh = reference.shared_mesh().unwrap();
-    let mut sim = reference
-        .simulation(Umls2::new(mesh), umls_engine::Flip { alpha: 0.99 })
-        .unwrap();
+    let mut sim = by_hand::disks(
+        Umls2::new(by_hand::disks_mesh()),
+        umls_engine::Flip { alpha: 0.99 },
+    );
     for _ in 0..50 {
         sim.step().unwrap();
     }
@@ -98,11 +96,7 @@ fn pic_from_a_file_is_the_library_pic() {
     let scene = Scene::parse(&text.replacen(flip, "kind = \"pic\"", 1), "pic.toml", None).unwrap();
     let report = run(&scene, &options("disks-pic", Some(0.05))).unwrap();
     assert_eq!(report.summary.to_json()["transfer"], "pic");
-    let reference = CollidingDisks::default();
-    let mesh = reference.shared_mesh().unwrap();
-    let mut sim = reference
-        .simulation(Umls2::new(mesh), umls_engine::Pic)
-        .unwrap();
+    let mut sim = by_hand::disks(Umls2::new(by_hand::disks_mesh()), umls_engine::Pic);
     for _ in 0..50 {
         sim.step().unwrap();
     }
@@ -123,14 +117,13 @@ fn bar_file_matches_the_hand_written_scene_error() {
     let file_rmse = report.summary.to_json()["metrics"]["velocity_rmse"]
         .as_f64()
         .unwrap();
-    let bar = VibratingBar {
+    let bar = Bar {
         cells: 50,
-        ..VibratingBar::default()
+        gradient_start: false,
     };
     let (steps, _) = bar.steps_and_dt();
     assert_eq!(report.summary.to_json()["steps"], steps);
-    let mesh = std::sync::Arc::new(bar.mesh().unwrap());
-    let expected = bar.run(Umls1::new(mesh), Apic).unwrap().velocity_rmse;
+    let expected = bar.velocity_rmse(Umls1::new(bar.mesh()), Apic);
     assert!(
         (file_rmse - expected).abs() < 1e-9 * expected,
         "{file_rmse} vs {expected}"
@@ -147,7 +140,6 @@ fn bar_file_matches_the_hand_written_scene_error() {
 /// affine matrices.
 #[test]
 fn a_body_starts_its_affine_matrices_at_the_velocity_gradient() {
-    use umls_scenes::vibrating_bar::AffineStart;
     let sine = r#"velocity = ["0.1 * sin(PI * x / 50)"]"#;
     let scene = with(
         "vibrating-bar",
@@ -155,10 +147,9 @@ fn a_body_starts_its_affine_matrices_at_the_velocity_gradient() {
         &format!("{sine}\naffine = \"velocity-gradient\""),
     );
     let seeds = build::<1>(&scene, segments).unwrap().seeds;
-    let bar = VibratingBar {
+    let bar = Bar {
         cells: 50,
-        affine_start: AffineStart::VelocityGradient,
-        ..VibratingBar::default()
+        gradient_start: true,
     };
     let expected = bar.particles::<()>();
     let largest = expected.affine.iter().fold(0.0f64, |m, c| m.max(c.amax()));
@@ -180,18 +171,12 @@ fn a_body_starts_its_affine_matrices_at_the_velocity_gradient() {
     let file_rmse = report.summary.to_json()["metrics"]["velocity_rmse"]
         .as_f64()
         .unwrap();
-    let mesh = std::sync::Arc::new(bar.mesh().unwrap());
-    let started = bar
-        .run(Umls1::new(mesh.clone()), Apic)
-        .unwrap()
-        .velocity_rmse;
-    let zero = VibratingBar {
-        cells: 50,
-        ..VibratingBar::default()
+    let started = bar.velocity_rmse(Umls1::new(bar.mesh()), Apic);
+    let zero = Bar {
+        gradient_start: false,
+        ..bar
     }
-    .run(Umls1::new(mesh), Apic)
-    .unwrap()
-    .velocity_rmse;
+    .velocity_rmse(Umls1::new(bar.mesh()), Apic);
     assert!(
         (file_rmse - started).abs() < 1e-8 * started,
         "{file_rmse} vs {started}"
