@@ -81,6 +81,9 @@ pub(crate) struct Totals<const D: usize> {
     pub fastest: (usize, f64),
     /// The first particle whose velocity or position G2P left non-finite.
     pub first_non_finite: Option<usize>,
+    /// The largest wave Courant number Δt / Δt_stable a step was asked to take, the one
+    /// the guard refused included.
+    pub max_wave_courant: f64,
 }
 
 impl<const D: usize> Default for Totals<D> {
@@ -98,6 +101,7 @@ impl<const D: usize> Default for Totals<D> {
             longest_move: (0, 0.0),
             fastest: (0, 0.0),
             first_non_finite: None,
+            max_wave_courant: 0.0,
         }
     }
 }

@@ -57,6 +57,8 @@ pub trait DynSimulation<const D: usize> {
     fn step_count(&self) -> usize;
     /// The last step's Δt.
     fn last_dt(&self) -> f64;
+    /// The largest wave Courant number of the steps so far, a refused one included.
+    fn max_wave_courant(&self) -> f64;
     /// Energies, momentum, speeds and Courant numbers now.
     fn diagnostics(&self) -> Result<Diagnostics<D>, EngineError>;
     /// The step settings.
@@ -140,6 +142,9 @@ where
     }
     fn last_dt(&self) -> f64 {
         Simulation::last_dt(self)
+    }
+    fn max_wave_courant(&self) -> f64 {
+        Simulation::max_wave_courant(self)
     }
     fn diagnostics(&self) -> Result<Diagnostics<D>, EngineError> {
         Simulation::diagnostics(self)

@@ -90,6 +90,23 @@ pub enum EngineError {
         /// The configured limit.
         limit: f64,
     },
+    /// The step would be stable at the body's speed, but one particle was kicked far
+    /// beyond it (a sliver simplex or a light node of the kernel, not the time step).
+    #[error(
+        "step {step}, particle {particle}: kicked to |v| = {speed:.4e}, {ratio:.1}× the particles' RMS speed; the step is stable at that speed, not at the kicked particle's (wave Courant number {wave_courant:.3} > the limit): the kick, not Δt, is the cause"
+    )]
+    ParticleKick {
+        /// Step number.
+        step: usize,
+        /// The kicked particle (its index at construction).
+        particle: usize,
+        /// Its speed.
+        speed: f64,
+        /// Its speed over the particles' mass-weighted RMS speed.
+        ratio: f64,
+        /// The wave Courant number Δt (c + |v|) / h at its speed.
+        wave_courant: f64,
+    },
     /// The time step exceeds the explicit stability limit.
     #[error(
         "step {step}: Δt = {dt:.4e} exceeds the stable step {stable:.4e} (wave Courant number {wave_courant:.3} > the limit): use a smaller dt or cfl, or an adaptive time step"
@@ -192,13 +209,26 @@ impl EngineError {
                 particle: id(particle),
                 reason,
             },
+            Self::ParticleKick {
+                step,
+                particle,
+                speed,
+                ratio,
+                wave_courant,
+            } => Self::ParticleKick {
+                step,
+                particle: id(particle),
+                speed,
+                ratio,
+                wave_courant,
+            },
             other => other,
         }
     }
 
     /// A short name of the kind of failure, for tables and stability maps: `kernel`,
     /// `material`, `non-finite`, `inverted`, `energy-blow-up`, `too-fast`,
-    /// `time-step-too-large`, `initial-stress`, `invalid-parameter` or `unsupported`.
+    /// `time-step-too-large`, `particle-kick`, `initial-stress`, `invalid-parameter` or `unsupported`.
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Kernel { .. } | Self::FacePoint { .. } => "kernel",
@@ -208,6 +238,7 @@ impl EngineError {
             Self::EnergyBlowUp { .. } => "energy-blow-up",
             Self::Unstable { .. } => "too-fast",
             Self::TimeStepTooLarge { .. } => "time-step-too-large",
+            Self::ParticleKick { .. } => "particle-kick",
             Self::InitialStress { .. } => "initial-stress",
             Self::InvalidParameter { .. } => "invalid-parameter",
             Self::Unsupported { .. } => "unsupported",

@@ -322,6 +322,14 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         self.dt
     }
 
+    /// The largest wave Courant number Δt / Δt_stable of the steps so far, measured as
+    /// the guard measures it (at the speeds and densities each step starts from), the
+    /// step the guard refused ([`EngineError::TimeStepTooLarge`]) included; 0 before the
+    /// first step.
+    pub fn max_wave_courant(&self) -> f64 {
+        self.totals.max_wave_courant
+    }
+
     /// The bytes the simulation holds, by what they grow with (after a step, the
     /// scratch buffers have their working size).
     pub fn memory_use(&self) -> crate::memory::MemoryUse {
@@ -370,6 +378,53 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                     .min(self.stable_step_from(cfl, max_speed, min_density))
             }
             _ => self.dt,
+        }
+    }
+
+    /// Why the guard refuses a step of `dt` against the stable step `stable`: one
+    /// particle kicked beyond the others' speed ([`EngineError::ParticleKick`]) where
+    /// the step is stable at the particles' mass-weighted RMS speed, else a step too
+    /// large for the waves and the body's motion ([`EngineError::TimeStepTooLarge`]).
+    fn step_refused(&self, step: usize, dt: f64, stable: f64) -> EngineError {
+        let wave_courant = dt / stable;
+        let p = &self.particles;
+        let (mass, energy) = p
+            .mass
+            .iter()
+            .zip(&p.velocity)
+            .fold((0.0, 0.0), |(m, e), (mp, v)| {
+                (m + mp, e + mp * v.norm_squared())
+            });
+        let rms = if mass > 0.0 {
+            (energy / mass).sqrt()
+        } else {
+            0.0
+        };
+        let at_rms = self.stable_step_from(1.0, rms, self.totals.min_density);
+        // The fastest particle now (the first among equals): the one the guard's speed is.
+        let (particle, speed) =
+            p.velocity
+                .iter()
+                .map(|v| v.norm())
+                .enumerate()
+                .fold(
+                    (0, 0.0),
+                    |best, (i, s)| if s > best.1 { (i, s) } else { best },
+                );
+        if rms > 0.0 && dt <= self.settings.max_wave_courant * at_rms {
+            return EngineError::ParticleKick {
+                step,
+                particle,
+                speed,
+                ratio: speed / rms,
+                wave_courant,
+            };
+        }
+        EngineError::TimeStepTooLarge {
+            step,
+            dt,
+            stable,
+            wave_courant,
         }
     }
 
@@ -589,13 +644,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         // The stability limit with the speeds and densities the step starts from (those
         // an adaptive step is sized by, so a cfl ≤ 1 never trips it).
         let stable = self.stable_step_from(1.0, self.totals.max_speed, self.totals.min_density);
+        self.totals.max_wave_courant = self.totals.max_wave_courant.max(dt / stable);
         if dt > self.settings.max_wave_courant * stable {
-            return Err(EngineError::TimeStepTooLarge {
-                step,
-                dt,
-                stable,
-                wave_courant: dt / stable,
-            });
+            return Err(self.step_refused(step, dt, stable));
         }
         let mut clock = Lap::start();
         // 1. Stencils. MUSL reads the start-of-step stencils after the particles have

@@ -169,6 +169,7 @@ fn linear_elasticity_under_apic_spin_is_the_cause_not_the_kernel() {
             EngineError::Inverted { .. }
                 | EngineError::EnergyBlowUp { .. }
                 | EngineError::TimeStepTooLarge { .. }
+                | EngineError::ParticleKick { .. }
                 | EngineError::Unstable { .. }
         ),
         "{error}"
@@ -491,6 +492,49 @@ fn unstable_time_step_is_reported() {
     let error = run(&mut sim, 400).unwrap_err();
     assert!(
         matches!(error, EngineError::TimeStepTooLarge { wave_courant, .. } if (wave_courant - 4.0).abs() < 0.1),
+        "{error}"
+    );
+}
+
+/// One particle far faster than the rest (the kick a sliver or a light node gives) makes
+/// the step unstable at its speed alone: the guard names the kick and the particle, not
+/// Δt. The whole body at that speed is a time step too large.
+#[test]
+fn a_kicked_particle_is_named_not_the_time_step() {
+    let grid = BSplineKernel::new(SVector::from([-0.2]), 0.1, [14], BSplineOrder::Quadratic)
+        .expect("grid");
+    let material = LinearElastic {
+        parameters: ElasticParameters::from_young_poisson(10.0, 0.0).unwrap(),
+    };
+    // c = √10, h = 0.1, Δt = 0.01: stable at the RMS speed √20 of one particle at 20
+    // among 20 at rest (Δt_stable 0.013), not at 20 (0.0043).
+    let refused = |speed: &dyn Fn(usize) -> f64| {
+        let x = (0..20)
+            .map(|i| SVector::from([0.025 + 0.05 * i as f64]))
+            .collect();
+        let mut particles = Particles::at_rest(x, vec![0.05; 20], 1.0, ());
+        for (i, v) in particles.velocity.iter_mut().enumerate() {
+            *v = SVector::from([speed(i)]);
+        }
+        let settings = StepSettings::new(0.01);
+        let mut sim = Simulation::new(grid.clone(), material, Pic, particles, settings).unwrap();
+        sim.step().unwrap_err()
+    };
+    match refused(&|i| if i == 7 { 20.0 } else { 0.0 }) {
+        EngineError::ParticleKick {
+            particle,
+            speed,
+            ratio,
+            ..
+        } => {
+            assert_eq!(particle, 7);
+            assert!((speed - 20.0).abs() < 1e-12 && (ratio - 20f64.sqrt()).abs() < 1e-9);
+        }
+        other => panic!("expected a kick: {other}"),
+    }
+    let error = refused(&|_| 20.0);
+    assert!(
+        matches!(error, EngineError::TimeStepTooLarge { .. }),
         "{error}"
     );
 }

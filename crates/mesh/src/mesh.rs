@@ -313,6 +313,17 @@ impl<const D: usize> SimplexMesh<D> {
         self.volumes.iter().sum()
     }
 
+    /// The mean element size (D! · V / n)^(1/D), with V the mesh's volume and n its
+    /// simplex count: the edge of the right-angled simplex (legs h, volume h^D / D!) of
+    /// the mean volume. On a lattice of cells h it is h however the cells are split and
+    /// however the interior vertices are jittered (jitter moves volume between
+    /// simplices, not out of the mesh), where the longest edge grows with the jitter.
+    pub fn mean_element_size(&self) -> f64 {
+        let factorial = (1..=D).product::<usize>() as f64;
+        let count = self.simplex_count().max(1) as f64;
+        (factorial * self.total_volume() / count).powf(1.0 / D as f64)
+    }
+
     /// Longest edge in the mesh.
     pub fn max_edge_length(&self) -> f64 {
         self.max_edge

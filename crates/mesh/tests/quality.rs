@@ -233,3 +233,38 @@ fn sample_rules_integrate_exactly() {
         1.0 + 0.25,
     );
 }
+
+/// The mean element size of a lattice of cells h is h for every split and every jitter,
+/// while the longest edge grows with the jitter (what made it a poor default for a grid's
+/// spacing on a mesh).
+#[test]
+fn mean_element_size_of_a_lattice_is_its_cell_size_under_jitter() {
+    let h = 0.05;
+    for jitter in [0.0, 0.1, 0.2] {
+        for diagonal in [Diagonal::Right, Diagonal::Alternating, Diagonal::Crossed] {
+            let mesh = Lattice::new([0.0, 0.0], [1.0, 0.5], [20, 10])
+                .jitter(jitter, 3)
+                .triangles(diagonal)
+                .unwrap();
+            // The crossed split has four triangles per cell: (2 · h²/4)^(1/2) = h/√2.
+            let expected = if diagonal == Diagonal::Crossed {
+                h / 2f64.sqrt()
+            } else {
+                h
+            };
+            let size = mesh.mean_element_size();
+            assert!(
+                (size - expected).abs() < 1e-12,
+                "{jitter} {diagonal:?}: {size}"
+            );
+        }
+        let tets = Lattice::new([0.0; 3], [1.0, 0.5, 0.5], [20, 10, 10])
+            .jitter(jitter, 3)
+            .tetrahedra()
+            .unwrap();
+        assert!((tets.mean_element_size() - h).abs() < 1e-12, "{jitter}");
+        if jitter > 0.0 {
+            assert!(tets.max_edge_length() / 3f64.sqrt() > 1.05 * h, "{jitter}");
+        }
+    }
+}

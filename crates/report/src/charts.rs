@@ -197,6 +197,7 @@ pub fn scaling(study: &ThroughputStudy, records: &[&Record]) -> LineChart {
 fn short_kind(kind: &str) -> &str {
     match kind {
         "time-step-too-large" => "Δt > stable",
+        "particle-kick" => "kick",
         "energy-blow-up" => "blow-up",
         "non-finite" => "NaN",
         "no-summary" => "no run",

@@ -54,7 +54,7 @@ pub(crate) fn drive<const D: usize>(
         failure: failure.as_ref(),
         wall,
         frames: out.frames(),
-        max_wave_courant: recorder.max_wave_courant(),
+        max_wave_courant: sim.max_wave_courant(),
     };
     let metrics = recorder.metrics(sim, failure.is_some())?;
     let summary = summarise(ctx, sim, &outcome, metrics);

@@ -43,6 +43,14 @@ pub trait KernelFactory<const D: usize> {
     /// The kernel over the scene's background (`setup.background`: a mesh, or the box
     /// of a lattice that a grid kernel does not split); errors name the scene key.
     fn build(&self, scene: &Scene, setup: &Setup<D>) -> Result<Self::Kernel>;
+
+    /// What the user should hear about running this kernel on `setup` (a set-up the
+    /// kernel is known to handle badly); the run's summary and plan repeat them. None by
+    /// default.
+    fn warnings(&self, setup: &Setup<D>) -> Vec<String> {
+        let _ = setup;
+        Vec::new()
+    }
 }
 
 /// A built-in kernel of `[kernel] kind`, with the UMLS kernel type of its dimension.
@@ -120,6 +128,35 @@ where
     fn build(&self, scene: &Scene, setup: &Setup<D>) -> Result<Self::Kernel> {
         Ok(LinearFeKernel::new(mesh(scene, setup)?))
     }
+    fn warnings(&self, setup: &Setup<D>) -> Vec<String> {
+        one_particle_per_cell(setup).into_iter().collect()
+    }
+}
+
+/// Below this many particles per simplex, linear elements are warned about.
+const FEW_PARTICLES_PER_CELL: f64 = 1.5;
+
+/// The warning for linear elements with about one particle per simplex: the particles
+/// are the elements' only quadrature points, so once they move, some simplices hold none
+/// (their nodes lose stiffness) and each crossing kicks the nodes it leaves; the energy
+/// can grow with nothing stopping the run. Particles per simplex are the mesh's mean
+/// simplex volume over the particles' mean volume.
+fn one_particle_per_cell<const D: usize>(setup: &Setup<D>) -> Option<String> {
+    let mesh = setup.background.mesh()?;
+    let volumes = &setup.seeds.volume;
+    if volumes.is_empty() || mesh.simplex_count() == 0 {
+        return None;
+    }
+    let particle = volumes.iter().sum::<f64>() / volumes.len() as f64;
+    let cell = mesh.total_volume() / mesh.simplex_count() as f64;
+    let per_cell = cell / particle;
+    (per_cell < FEW_PARTICLES_PER_CELL).then(|| {
+        format!(
+            "linear-fe with {per_cell:.2} particles per simplex: simplices that particles \
+             leave have no stiffness and each crossing kicks their nodes, so the energy may \
+             grow; seed two or more per simplex (e.g. `seeding = {{ mesh = \"gauss2\" }}`)"
+        )
+    })
 }
 
 impl<const D: usize> KernelFactory<D> for BuiltIn<UgimpKernel<D>> {
@@ -267,19 +304,16 @@ fn mls_kernel<const D: usize>(
 const MAX_GRID_NODES: f64 = 1e8;
 
 /// The grid spacing of a grid kernel: `[kernel] grid_spacing`, else the lattice's cell
-/// size, else the mesh's longest edge / √D.
+/// size, else the mesh's mean element size (`SimplexMesh::mean_element_size`, the cell
+/// size of a lattice however it is split or jittered; the longest edge grew with the
+/// jitter and coarsened the grid with it).
 fn grid_spacing<const D: usize>(scene: &Scene, setup: &Setup<D>) -> Result<f64> {
     let h = scene
         .spec
         .kernel
         .grid_spacing
         .or(setup.lattice_spacing)
-        .or_else(|| {
-            setup
-                .background
-                .mesh()
-                .map(|mesh| mesh.max_edge_length() / (D as f64).sqrt())
-        })
+        .or_else(|| setup.background.mesh().map(|mesh| mesh.mean_element_size()))
         .unwrap_or(f64::NAN);
     if !(h.is_finite() && h > 0.0) {
         return Err(scene.value_error("kernel.grid_spacing", "must be positive"));

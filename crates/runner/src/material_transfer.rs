@@ -82,6 +82,9 @@ fn start<const D: usize, K: Kernel<D> + 'static, P: PlasticPart<D> + 'static>(
     settings.particle_sort_interval = ctx.scene.spec.kernel.particle_sort_interval;
     settings.mass_matrix = crate::schema::MassSpec::matrix(ctx.scene.spec.transfer.mass);
     settings.damping = ctx.setup.damping;
+    if let Some(limit) = ctx.scene.spec.time.max_wave_courant {
+        settings.max_wave_courant = limit;
+    }
     let mut sim = Simulation::new(kernel, table, transfer, particles, settings)?;
     if let Some((field, position)) = &ctx.setup.body_force {
         let (field, frame) = (field.clone(), ctx.setup.frame);

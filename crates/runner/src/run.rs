@@ -324,7 +324,10 @@ where
         EncodingSpec::Binary => Encoding::Binary,
         EncodingSpec::Ascii => Encoding::Ascii,
     };
+    let mut setup = setup;
     let kernel = factory.build(scene, &setup)?;
+    let warnings = factory.warnings(&setup);
+    setup.warnings.extend(warnings);
     let ctx = Context {
         scene,
         kernel_name: factory.name(),

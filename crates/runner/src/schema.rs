@@ -524,6 +524,10 @@ pub struct TimeSpec {
     /// also given, is the largest step).
     #[serde(default)]
     pub adaptive: bool,
+    /// The guard: the largest wave Courant number Δt (c + |v|_max) / h a step may take
+    /// before the run stops (default 1; `inf` switches it off, for a kernel whose stable
+    /// step exceeds the spacing's estimate).
+    pub max_wave_courant: Option<f64>,
 }
 
 /// `[output]`.

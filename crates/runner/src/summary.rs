@@ -60,7 +60,8 @@ pub struct RunSummary {
     pub stable_dt: f64,
     /// Whether a fixed Δt exceeds `stable_dt`.
     pub dt_exceeds_stable: bool,
-    /// The largest wave Courant number of the recorded rows.
+    /// The largest wave Courant number Δt / Δt_stable a step was asked to take, measured
+    /// as the guard measures it; the step the guard refused included.
     pub max_wave_courant: f64,
     /// What the user should hear about the set-up and the run.
     pub warnings: Vec<String>,

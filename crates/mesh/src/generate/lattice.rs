@@ -121,7 +121,10 @@ impl<const D: usize> Lattice<D> {
         index as u32
     }
 
-    fn validate(&self) -> Result<(), MeshError> {
+    /// Checks the parameters as the generators do before building: cells, bounds,
+    /// spacing ratios, jitter (≤ [`MAX_JITTER`]) and rotation. For a caller that uses the
+    /// lattice's box without building its simplices, so that it refuses what they refuse.
+    pub fn validate(&self) -> Result<(), MeshError> {
         let bad = |parameter, value: String, reason| {
             Err(MeshError::InvalidParameter {
                 parameter,

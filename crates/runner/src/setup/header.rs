@@ -32,6 +32,14 @@ pub fn check_header(scene: &Scene) -> Result<()> {
             ));
         }
     }
+    if let Some(limit) = spec.time.max_wave_courant {
+        if limit.is_nan() || limit <= 0.0 {
+            return Err(scene.value_error(
+                "time.max_wave_courant",
+                "must be positive (`inf` switches the guard off)",
+            ));
+        }
+    }
     match (spec.output.frames, spec.output.interval) {
         (Some(_), Some(_)) => {
             return Err(scene.value_error("output", "give at most one of `frames` and `interval`"));

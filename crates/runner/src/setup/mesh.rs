@@ -125,12 +125,11 @@ fn background<const D: usize>(scene: &Scene, split: Split<D>, lean: bool) -> Res
                 DiagonalSpec::Crossed => Diagonal::Crossed,
             };
             if lean {
-                if (0..D).any(|k| upper[k] <= lower[k]) {
-                    return Err(scene.value_error(
-                        "mesh.lattice",
-                        "`upper` must exceed `lower` in every component",
-                    ));
-                }
+                // The same checks as the split's, so that a scene is refused or accepted
+                // alike whatever the kernel.
+                lattice
+                    .validate()
+                    .map_err(|e| scene.value_error("mesh.lattice", e.to_string()))?;
                 let frame = SceneFrame::default();
                 return Ok((
                     Background::Box {
