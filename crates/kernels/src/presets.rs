@@ -135,38 +135,37 @@ impl Preset {
             ..umls
         };
         let incident = |factor| SupportRadius::IncidentEdge { factor };
-        let of_uncorrected = |settings| PresetFamily::Umls(settings);
         match self {
             Preset::Umls => PresetFamily::Umls(umls),
             Preset::UmlsQuadratic => PresetFamily::UmlsQuadratic(UmlsPreset {
                 higher_order_ridge: QUADRATIC_RIDGE,
                 ..uncorrected
             }),
-            Preset::UmlsWendland => of_uncorrected(UmlsPreset {
+            Preset::UmlsWendland => PresetFamily::Umls(UmlsPreset {
                 profile: Profile::WendlandC2,
                 ..uncorrected
             }),
-            Preset::UmlsSharp => of_uncorrected(UmlsPreset {
+            Preset::UmlsSharp => PresetFamily::Umls(UmlsPreset {
                 profile: sharpened(DEFAULT_SHARPENING),
                 ..uncorrected
             }),
-            Preset::UmlsWide => of_uncorrected(UmlsPreset {
+            Preset::UmlsWide => PresetFamily::Umls(UmlsPreset {
                 support: SupportRadius::PerVertex { factor: 1.0 },
                 ..uncorrected
             }),
-            Preset::UmlsPaper => of_uncorrected(UmlsPreset {
+            Preset::UmlsPaper => PresetFamily::Umls(UmlsPreset {
                 support: SupportRadius::Global { factor: 1.0 },
                 ..uncorrected
             }),
-            Preset::UmlsFullGradient => of_uncorrected(UmlsPreset {
+            Preset::UmlsFullGradient => PresetFamily::Umls(UmlsPreset {
                 gradient: GradientKind::Full,
                 ..uncorrected
             }),
-            Preset::UmlsFrozenEta => of_uncorrected(UmlsPreset {
+            Preset::UmlsFrozenEta => PresetFamily::Umls(UmlsPreset {
                 gradient: GradientKind::FrozenEta,
                 ..uncorrected
             }),
-            Preset::UmlsUncorrected => of_uncorrected(uncorrected),
+            Preset::UmlsUncorrected => PresetFamily::Umls(uncorrected),
             Preset::UmlsEta4 => PresetFamily::Umls(UmlsPreset {
                 support: incident(ETA4_SUPPORT_FACTOR),
                 diminishing_exponent: ETA4_EXPONENT,
@@ -271,6 +270,20 @@ impl UmlsPreset {
         let mls = self
             .mls_kernel(&mesh)
             .map_err(|e| KernelError::evaluation("UMLS", e))?;
+        self.mesh_kernel(mesh, mls)
+    }
+
+    /// The mesh kernel over `mls` (built by [`Self::mls_kernel`]) with these settings'
+    /// gradient and, where they ask for it, the integration correction (whose fits may
+    /// fail).
+    pub fn mesh_kernel<const D: usize, const N: usize, B: PolynomialBasis<D, N>>(
+        &self,
+        mesh: Arc<SimplexMesh<D>>,
+        mls: UmlsKernel<D, Profile>,
+    ) -> Result<UmlsMeshKernel<D, N, B, Profile>, KernelError>
+    where
+        UmlsMeshKernel<D, N, B, Profile>: Kernel<D>,
+    {
         let kernel = UmlsMeshKernel::with_kernel(mesh, mls).with_gradient(self.gradient);
         if self.integration_correction {
             kernel.with_integration_correction()

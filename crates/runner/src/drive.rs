@@ -126,7 +126,7 @@ fn step_to_end<const D: usize>(
             step % history_every == 0 || sim.time() + 1.5 * dt >= end;
         sim.step_until(ctx.end_time)?;
         recorder.after_step(sim)?;
-        if step % history_every == 0 || sim.time() >= end {
+        if step % history_every == 0 || sim.reached(ctx.end_time) {
             recorder.record(sim)?;
         }
         if next_frame < frames && sim.time() >= frame_time(next_frame) - 0.5 * dt {

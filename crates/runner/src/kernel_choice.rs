@@ -11,7 +11,7 @@
 use std::sync::Arc;
 
 use umls_kernels::presets::{Preset, PresetFamily, UmlsPreset};
-use umls_kernels::{BSplineKernel, BSplineOrder, GradientKind, LinearFeKernel, UmlsMeshKernel};
+use umls_kernels::{BSplineKernel, BSplineOrder, LinearFeKernel, UmlsMeshKernel};
 use umls_mesh::SimplexMesh;
 use umls_mls::{
     DEFAULT_SHARPENING, MlsError, Profile, SharpenedBSpline, SupportRadius, UmlsKernel,
@@ -80,22 +80,6 @@ fn mesh<const D: usize>(scene: &Scene, setup: &Setup<D>) -> Result<Arc<SimplexMe
     })
 }
 
-/// The UMLS kernel of `kind` on the scene's mesh, as type `U`.
-fn umls<const D: usize, U: FromMls<D>>(
-    scene: &Scene,
-    setup: &Setup<D>,
-    kind: KernelKind,
-) -> Result<U> {
-    let mesh = mesh(scene, setup)?;
-    let settings = umls_settings(scene, kind)?;
-    let mls = mls_kernel(scene, &settings, &mesh)?;
-    corrected(
-        scene,
-        &settings,
-        U::from_mls(mesh, (mls, settings.gradient)),
-    )
-}
-
 impl<const D: usize, const N: usize, B> KernelFactory<D>
     for BuiltIn<UmlsMeshKernel<D, N, B, Profile>>
 where
@@ -110,7 +94,12 @@ where
         true
     }
     fn build(&self, scene: &Scene, setup: &Setup<D>) -> Result<Self::Kernel> {
-        umls(scene, setup, self.kind)
+        let mesh = mesh(scene, setup)?;
+        let settings = umls_settings(scene, self.kind)?;
+        let mls = mls_kernel(scene, &settings, &mesh)?;
+        settings
+            .mesh_kernel(mesh, mls)
+            .map_err(|e| scene.value_error("kernel.integration_correction", e.to_string()))
     }
 }
 
@@ -187,49 +176,6 @@ impl<const D: usize> KernelFactory<D> for BuiltIn<BSplineKernel<D>> {
         };
         bspline(scene, setup, order)
     }
-}
-
-/// A UMLS kernel type built from a mesh, MLS settings and the gradient kind: what
-/// differs per dimension is only the basis size, the construction is the same for all.
-pub trait FromMls<const D: usize>: Sized {
-    /// The kernel on `mesh` with these MLS settings and gradient.
-    fn from_mls(
-        mesh: Arc<SimplexMesh<D>>,
-        settings: (UmlsKernel<D, Profile>, GradientKind),
-    ) -> Self;
-
-    /// The kernel with its force's integration correction.
-    fn with_integration_correction(self) -> std::result::Result<Self, umls_transfer::KernelError>;
-}
-
-impl<const D: usize, const N: usize, B: umls_mls::PolynomialBasis<D, N>> FromMls<D>
-    for UmlsMeshKernel<D, N, B, Profile>
-{
-    fn from_mls(
-        mesh: Arc<SimplexMesh<D>>,
-        (mls, gradient): (UmlsKernel<D, Profile>, GradientKind),
-    ) -> Self {
-        Self::with_kernel(mesh, mls).with_gradient(gradient)
-    }
-
-    fn with_integration_correction(self) -> std::result::Result<Self, umls_transfer::KernelError> {
-        UmlsMeshKernel::with_integration_correction(self)
-    }
-}
-
-/// The UMLS kernel with its force's integration correction where the settings (the
-/// preset's, or `[kernel] integration_correction`) ask for it.
-fn corrected<const D: usize, K: FromMls<D>>(
-    scene: &Scene,
-    settings: &UmlsPreset,
-    kernel: K,
-) -> Result<K> {
-    if !settings.integration_correction {
-        return Ok(kernel);
-    }
-    kernel
-        .with_integration_correction()
-        .map_err(|e| scene.value_error("kernel.integration_correction", e.to_string()))
 }
 
 /// The settings of the UMLS preset `kind` (`umls_kernels::presets`) with `[kernel]`'s
