@@ -101,6 +101,25 @@ impl PointCloud {
         self.ambient
     }
 
+    /// Diagonal of the samples' bounding box (0 for a single position).
+    pub fn extent(&self) -> f64 {
+        let n = self.ambient_dim();
+        (0..n)
+            .map(|c| {
+                let (lo, hi) = self
+                    .points()
+                    .iter()
+                    .skip(c)
+                    .step_by(n)
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+                        (lo.min(x), hi.max(x))
+                    });
+                (hi - lo) * (hi - lo)
+            })
+            .sum::<f64>()
+            .sqrt()
+    }
+
     /// Values per sample k.
     pub fn value_dim(&self) -> usize {
         self.value_dim

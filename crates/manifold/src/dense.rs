@@ -87,6 +87,64 @@ pub(crate) fn least_squares(
     Conditioning { condition }
 }
 
+/// What the noise in a weighted fit does, for a fit [`least_squares`] solved: with
+/// √W P = Q₁ R S (S the column scaling), leverages h_i = ‖Q₁ row i‖² and the value
+/// coefficient's equivalent kernel l_i = √w_i (Q₁ R⁻ᵀ e₀)_i / s₀.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct NoiseResponse {
+    /// Σ w_i (1 − h_i): a residual's expected weighted sum of squares over the variance
+    /// of homoscedastic noise, E Σ w_i r_i² = s² Σ w_i (1 − h_i).
+    pub residual_dof: f64,
+    /// ‖l‖: the standard deviation of the fitted value over the noise's.
+    pub kernel_norm: f64,
+}
+
+/// [`NoiseResponse`] of a fit: `r` is the matrix [`least_squares`] left (R in its upper
+/// triangle), `scale` its column scaling, `design` the unscaled √W P it factored, and
+/// `weights` the w_i. `buffer` needs `2·cols` entries.
+pub(crate) fn noise_response(
+    r: &[f64],
+    rows: usize,
+    cols: usize,
+    design: &[f64],
+    scale: &[f64],
+    weights: &[f64],
+    buffer: &mut Vec<f64>,
+) -> NoiseResponse {
+    buffer.clear();
+    buffer.resize(2 * cols, 0.0);
+    let (z, q) = buffer.split_at_mut(cols);
+    // Rᵀ z = e₀ by forward substitution.
+    for j in 0..cols {
+        let mut s = if j == 0 { 1.0 } else { 0.0 };
+        for l in 0..j {
+            s -= r[l + j * rows] * z[l];
+        }
+        z[j] = s / r[j + j * rows];
+    }
+    let (mut residual_dof, mut kernel) = (0.0, 0.0);
+    for (i, w) in weights.iter().enumerate().take(rows) {
+        // Row i of Q₁: Rᵀ q = S⁻¹ (row i of √W P).
+        let mut leverage = 0.0;
+        let mut along = 0.0;
+        for j in 0..cols {
+            let mut s = design[i + j * rows] / scale[j];
+            for l in 0..j {
+                s -= r[l + j * rows] * q[l];
+            }
+            q[j] = s / r[j + j * rows];
+            leverage += q[j] * q[j];
+            along += q[j] * z[j];
+        }
+        residual_dof += w * (1.0 - leverage);
+        kernel += w * along * along;
+    }
+    NoiseResponse {
+        residual_dof,
+        kernel_norm: kernel.sqrt() / scale[0],
+    }
+}
+
 /// σ_max / σ_min of a square `n`×`n` matrix by one-sided Jacobi (the matrix is destroyed).
 pub(crate) fn condition_number(g: &mut [f64], n: usize) -> f64 {
     for _sweep in 0..60 {

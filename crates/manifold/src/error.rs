@@ -107,6 +107,15 @@ pub enum ManifoldError {
         /// Smallest radius of curvature towards the query.
         radius: f64,
     },
+    /// The fit raised a [`crate::Concerns`] concern and the settings refuse such fits
+    /// ([`crate::Settings::refuse_untrustworthy`]).
+    #[error("untrustworthy fit at bandwidth σ = {sigma:.4e}: {concern}")]
+    Untrustworthy {
+        /// The first concern raised.
+        concern: &'static str,
+        /// The bandwidth of the fit.
+        sigma: f64,
+    },
     /// A neighbour index asked about a cloud it was not built from.
     #[error("the neighbour index was built from a different point cloud")]
     ForeignCloud,

@@ -11,10 +11,13 @@
 //! projection of r onto the manifold. The error is O(h^{m+1}) for smooth noiseless data
 //! and the cost per query is linear in n.
 //!
-//! Every [`Estimate`] carries a [`FitQuality`] (condition number, neighbours, iterations,
-//! widening). A fit that stays ill-conditioned after widening σ, and a query with no
-//! well-defined chart (far from the samples, or at a centre of curvature), is an error,
-//! never a silent value. docs/manifold-mls.md records every choice with its measurement.
+//! σ follows the local sample spacing, times a growth chosen per cloud by leave-one-out
+//! cross-validation ([`Bandwidth::Adaptive`], the default): 1 on clean data, wider on
+//! noisy data, so the error keeps falling with N at fixed noise. Every [`Estimate`]
+//! carries a [`FitQuality`] (condition number, effective samples, estimated noise and
+//! standard error, σ over the local reach) and its [`Concerns`]. A fit that stays
+//! ill-conditioned after widening σ, and a query with no well-defined chart (far from the
+//! samples, or at a centre of curvature), is an error, never a silent value. docs/manifold-mls.md records every choice with its measurement.
 //!
 //! ```
 //! use umls_manifold::{ManifoldMls, PointCloud, Settings};
@@ -53,7 +56,7 @@ mod polynomial;
 pub use chart::{ANDERSON_MEMORY, Chart, theta};
 pub use cloud::PointCloud;
 pub use error::ManifoldError;
-pub use mmls::{Bandwidth, Estimate, FitQuality, ManifoldMls, Settings};
+pub use mmls::{Bandwidth, Concerns, Estimate, FitQuality, ManifoldMls, Settings};
 /// The linear-algebra crate of [`Chart`] and [`Estimate`]: use it to name their types
 /// without a dependency of your own.
 pub use nalgebra;

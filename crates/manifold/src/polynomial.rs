@@ -2,7 +2,7 @@
 //! values and offsets in a chart.
 
 use crate::chart::{FrameChart, theta};
-use crate::dense::{dot, least_squares};
+use crate::dense::{NoiseResponse, dot, least_squares, noise_response};
 use crate::error::ManifoldError;
 use crate::frame::Frame;
 
@@ -122,6 +122,10 @@ pub(crate) struct FitScratch {
     x: Vec<f64>,
     lsq: Vec<f64>,
     used: Vec<(usize, f64)>,
+    /// √W P before the factorisation, for the fit's response to noise.
+    unscaled: Vec<f64>,
+    weights: Vec<f64>,
+    buffer: Vec<f64>,
 }
 
 /// What a fit in the chart produced.
@@ -134,6 +138,8 @@ pub(crate) struct FitSummary {
     pub condition: f64,
     /// Kish's effective sample size (Σw)² / Σw².
     pub effective: f64,
+    /// How noise in the samples propagates to the fit.
+    pub noise: NoiseResponse,
 }
 
 /// Weighted degree-m fit in the chart of the `k` values of every neighbour (from
@@ -203,6 +209,9 @@ pub(crate) fn fit_values_and_offsets<'v>(
             scratch.solution[r + (k + c) * rows] = sw * (y - q);
         }
     }
+    scratch.unscaled.clone_from(&scratch.design);
+    scratch.weights.clear();
+    scratch.weights.extend(scratch.used.iter().map(|&(_, w)| w));
     let conditioning = least_squares(
         &mut scratch.design,
         rows,
@@ -211,10 +220,27 @@ pub(crate) fn fit_values_and_offsets<'v>(
         columns,
         &mut scratch.lsq,
     );
+    let noise = if conditioning.condition.is_finite() {
+        noise_response(
+            &scratch.design,
+            rows,
+            m,
+            &scratch.unscaled,
+            &scratch.lsq[m * m..m * m + m],
+            &scratch.weights,
+            &mut scratch.buffer,
+        )
+    } else {
+        NoiseResponse {
+            residual_dof: 0.0,
+            kernel_norm: f64::INFINITY,
+        }
+    };
     Ok(FitSummary {
         rows,
         condition: conditioning.condition,
         effective: sum * sum / sum2,
+        noise,
     })
 }
 
