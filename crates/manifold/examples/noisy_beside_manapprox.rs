@@ -138,6 +138,10 @@ fn main() {
             }
             theirs.add(p[0], q[n], &p[1..=n], &q[..n]);
         }
+        let concerns = format!(
+            "noise {}, unresolved {}, few {}, reach {}",
+            raised[0], raised[1], raised[2], raised[3]
+        );
         let peer_time = peer.iter().map(|p| p[n + 1]).sum::<f64>() / peer.len() as f64;
         println!(
             "| {} | {:.2} | {:.3e} | {:.3e} | {:.2} | {:.3e} | {:.3e} | {:.3e} | {:.3e} | {} / {} ({}) | {:.0} | {:.0} |",
@@ -152,10 +156,7 @@ fn main() {
             theirs.worst_projection,
             ours.failures,
             flagged,
-            format!(
-                "noise {}, unresolved {}, few {}, reach {}",
-                raised[0], raised[1], raised[2], raised[3]
-            ),
+            concerns,
             per_query * 1e6,
             peer_time * 1e6,
         );

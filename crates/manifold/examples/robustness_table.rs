@@ -3,7 +3,8 @@
 //!   s ∈ {0.01 … 0.05}, m = 1…3, 400 queries: failures, max error, mean chart
 //!   iterations, time per query, largest condition number and widening;
 //! - `torus`: the flat torus in R⁶ sampled 11× coarser in v (grid `TORUS=ku,kv`, default
-//!   440,40), bandwidth factors 3–30, 200 queries: failures, max error, errors > 0.1;
+//!   440,40), bandwidth factors 3–30, 200 queries: failures (the first one's reason),
+//!   max error, errors > 0.1; `WIDENING=4,16` compares limits of the widening;
 //! - `offset`: projection of queries 0.05 off S², N = 8k/32k/128k, with observed orders.
 //!
 //! `cargo run --release -p umls-manifold --example robustness_table [noise|torus|offset]`
@@ -73,10 +74,21 @@ fn main() {
             })
             .unwrap_or((440, 40));
         let cloud = torus.cloud(ku, kv);
+        let widenings: Vec<f64> = std::env::var("WIDENING")
+            .ok()
+            .map(|s| s.split(',').map(|x| x.parse().unwrap()).collect())
+            .unwrap_or(vec![Settings::new(2, 1).max_widening]);
         for factor in [3.0, 10.0, 20.0, 30.0] {
-            for m in [1usize, 2] {
+            for (m, max_widening) in [1usize, 2]
+                .into_iter()
+                .flat_map(|m| widenings.iter().map(move |w| (m, *w)))
+            {
+                if widenings.len() > 1 {
+                    print!("max_widening {max_widening}: ");
+                }
                 let settings = Settings {
                     bandwidth: Bandwidth::Neighbours { factor, scale: 2.0 },
+                    max_widening,
                     ..Settings::new(2, m)
                 };
                 let mls = ManifoldMls::new(cloud.clone(), settings).unwrap();
@@ -90,7 +102,12 @@ fn main() {
                             conds.push(e.quality.condition);
                             errs.push(er)
                         }
-                        Err(_) => fails += 1,
+                        Err(e) => {
+                            if fails == 0 {
+                                eprintln!("first failure: {e}");
+                            }
+                            fails += 1
+                        }
                     }
                 }
                 let bad = errs.iter().filter(|&&e| e > 0.1).count();
@@ -98,8 +115,8 @@ fn main() {
                 println!(
                     "torus factor {factor} m={m}: fails {fails}, max err {:.3e}, err>0.1: {bad}, cond median {:.1} max {:.1}",
                     errs.iter().fold(0.0f64, |a, &b| a.max(b)),
-                    conds[conds.len() / 2],
-                    conds.last().unwrap()
+                    conds.get(conds.len() / 2).copied().unwrap_or(f64::NAN),
+                    conds.last().copied().unwrap_or(f64::NAN)
                 );
             }
         }

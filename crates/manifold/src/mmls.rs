@@ -117,7 +117,7 @@ pub struct Settings {
 impl Settings {
     /// Degree-`degree` approximation of a `intrinsic_dim`-manifold with the default
     /// bandwidth, tolerance 10⁻¹⁰, at most 100 chart iterations, condition limit 100,
-    /// widening up to 4×, queries up to 3σ from the samples, and doubtful fits returned
+    /// widening up to 16×, queries up to 3σ from the samples, and doubtful fits returned
     /// with their concerns.
     pub fn new(intrinsic_dim: usize, degree: usize) -> Self {
         Self {
@@ -127,7 +127,7 @@ impl Settings {
             tolerance: 1e-10,
             max_iterations: 100,
             max_condition: 100.0,
-            max_widening: 4.0,
+            max_widening: 16.0,
             max_offset: 3.0,
             refuse_untrustworthy: false,
         }
@@ -244,6 +244,10 @@ pub struct Estimate {
     pub gradient: DMatrix<f64>,
     /// Projection of r onto the reconstructed manifold, q + g(0).
     pub projection: Vec<f64>,
+    /// Tangent vectors of the reconstructed manifold at the projection, n×d: ∂g/∂x_j(0)
+    /// of the offset fit. The chart's plane H is tilted from them by O(σ²); they are
+    /// accurate to the fit's order.
+    pub tangent: DMatrix<f64>,
     /// The chart the fit used.
     pub chart: Chart,
     /// How far to trust the answer.
@@ -251,9 +255,16 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    /// Gradient as tangent vectors in Rⁿ (n×k): U times the chart gradient.
+    /// Gradient as tangent vectors in Rⁿ (n×k): the vectors of the reconstructed tangent
+    /// space whose derivatives along the manifold's coordinates are the chart gradient,
+    /// T (TᵀT)⁻¹ ∇ₓf̃ with T = [`Estimate::tangent`]. Using the chart's plane U instead
+    /// would cost an order: its O(σ²) tilt caps the gradient's error at O(h²).
     pub fn ambient_gradient(&self) -> DMatrix<f64> {
-        &self.chart.basis * self.gradient.transpose()
+        let t = &self.tangent;
+        match (t.transpose() * t).cholesky() {
+            Some(gram) => t * gram.solve(&self.gradient.transpose()),
+            None => &self.chart.basis * self.gradient.transpose(),
+        }
     }
 }
 
@@ -812,10 +823,24 @@ impl ManifoldMls {
             let column = ws.frame.direction(&ws.chart.u[j * dim..(j + 1) * dim]);
             basis.set_column(j, &DVector::from_vec(column));
         }
+        let tangent = if self.settings.degree >= 1 {
+            let mut tangent = DMatrix::<f64>::zeros(n, d);
+            let mut along = vec![0.0; dim];
+            for j in 0..d {
+                for (c, a) in along.iter_mut().enumerate() {
+                    *a = solution[1 + j + (k + c) * rows] / sigma;
+                }
+                tangent.set_column(j, &DVector::from_vec(ws.frame.direction(&along)));
+            }
+            tangent
+        } else {
+            basis.clone()
+        };
         Ok(Estimate {
             value,
             gradient,
             projection,
+            tangent,
             chart: Chart {
                 origin: DVector::from_vec(ws.frame.point(&ws.chart.q)),
                 basis,
@@ -1122,7 +1147,7 @@ fn curvature_vector(
         }
     }
     let det = s00 * s11 - s01 * s01;
-    if !(det > 1e-12 * s00 * s11) {
+    if det.is_nan() || det <= 1e-12 * s00 * s11 {
         return vec![0.0; dim];
     }
     let mut kappa: Vec<f64> = (0..dim)

@@ -123,6 +123,22 @@ fn anisotropic_torus_is_accurate_or_reported() {
     }
 }
 
+/// Grids 44× and 88× coarser in v: the rule's σ holds one line of samples, and widening
+/// (up to 16×, the default) reaches the next lines. Every query is answered; a degree-2
+/// fit across lines 0.63 apart is accurate to 2 %.
+#[test]
+fn strongly_anisotropic_grids_are_answered() {
+    let torus = common::Torus::new();
+    for ku in [440, 880] {
+        let mls = ManifoldMls::new(torus.cloud(ku, 10), Settings::new(2, 2)).unwrap();
+        let errors = torus_errors(&torus, &mls);
+        let failed = errors.iter().filter(|e| e.is_err()).count();
+        let worst = errors.iter().flatten().copied().fold(0.0, f64::max);
+        assert_eq!(failed, 0, "{ku} × 10: {failed} failed");
+        assert!(worst < 0.02, "{ku} × 10: max error {worst}");
+    }
+}
+
 /// Queries 0.05 off S² (3.5 spacings at the finest level, inside and outside): the
 /// projection keeps order ≥ m + 0.5 because σ is measured from the nearest sample,
 /// not from the query.
