@@ -72,7 +72,7 @@ impl Bandwidth {
 
 /// Samples left out, one at a time, to choose an adaptive bandwidth's growth.
 /// Largest polynomial basis C(d + m, d) a fit may have.
-const MAX_COEFFICIENTS: usize = 500;
+const MAX_COEFFICIENTS: usize = 200;
 
 /// Samples of the cross-validation's first stage, which tells clean data from noisy.
 const SCREENING_SAMPLES: usize = 200;
@@ -325,14 +325,15 @@ impl ManifoldMls {
         }
         validate(&settings)?;
         let monomials = Monomials::new(d, settings.degree)?;
-        // A fit costs O(K · C²) and its condition check O(C³) per query: beyond a few
+        // A fit costs O(K · C²) and its condition check O(C³) per attempt: beyond a few
         // hundred coefficients one query takes minutes, and monomials of such degree in
-        // σ-scaled coordinates are too ill-conditioned to fit anyway.
+        // σ-scaled coordinates are too ill-conditioned to fit anyway. 200 allows m = 18
+        // for surfaces and m = 5 in four variables.
         if monomials.len() > MAX_COEFFICIENTS {
             return Err(ManifoldError::InvalidParameter {
                 parameter: "degree",
                 value: settings.degree as f64,
-                reason: "C(d + m, d) coefficients exceed 500: lower the degree m",
+                reason: "C(d + m, d) coefficients exceed 200: lower the degree m",
             });
         }
         if let Bandwidth::Fixed(sigma) = settings.bandwidth {
