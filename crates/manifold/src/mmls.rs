@@ -151,7 +151,8 @@ pub struct FitQuality {
     /// Distance from the query to its projection, over σ.
     pub offset: f64,
     /// Standard deviation of the noise in the values, estimated from the fit's
-    /// residual (RMS over value components; ∞ when the fit leaves no residual freedom).
+    /// residual (RMS over value components; 0 for a cloud without values; ∞ when the fit
+    /// leaves no residual freedom).
     pub noise: f64,
     /// Standard deviation of the samples' offsets from the fitted manifold, estimated the
     /// same way.
@@ -1098,7 +1099,11 @@ fn residual_noise(
     if residual_dof <= 0.0 || rows <= coefficients {
         return (f64::INFINITY, f64::INFINITY);
     }
-    let value = ((0..k).map(squares).sum::<f64>() / (k as f64 * residual_dof)).sqrt();
+    let value = if k == 0 {
+        0.0
+    } else {
+        ((0..k).map(squares).sum::<f64>() / (k as f64 * residual_dof)).sqrt()
+    };
     let columns = solution.len() / rows;
     let position = if codim == 0 {
         0.0

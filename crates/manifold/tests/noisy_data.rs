@@ -110,6 +110,7 @@ fn noise_estimates_match_the_noise_put_in() {
         },
         ..Settings::new(2, 1)
     };
+    let coords_only = coords.clone();
     let mls = ManifoldMls::new(PointCloud::new(3, coords, 1, values).unwrap(), settings).unwrap();
     let (mut noise, mut position, mut predicted, mut squares) = (0.0, 0.0, 0.0, 0.0);
     let count = 400;
@@ -122,6 +123,15 @@ fn noise_estimates_match_the_noise_put_in() {
         squares += (estimate.value[0] - x - 2.0 * y).powi(2) / count as f64;
     }
     assert!((noise / 0.05 - 1.0).abs() < 0.1, "value noise {noise}");
+    // Positions alone: no value noise, the same position noise.
+    let positions = ManifoldMls::new(PointCloud::from_points(3, coords_only).unwrap(), settings)
+        .unwrap()
+        .evaluate(&[0.5, 0.5, 0.0])
+        .unwrap()
+        .quality;
+    assert_eq!(positions.noise, 0.0);
+    assert_eq!(positions.standard_error, 0.0);
+    assert!((positions.position_noise / 0.004 - 1.0).abs() < 0.3);
     assert!(
         (position / 0.004 - 1.0).abs() < 0.1,
         "position noise {position}"
