@@ -17,7 +17,8 @@
 //! carries a [`FitQuality`] (condition number, effective samples, estimated noise and
 //! standard error, σ over the local reach) and its [`Concerns`]. A fit that stays
 //! ill-conditioned after widening σ, and a query with no well-defined chart (far from the
-//! samples, or at a centre of curvature), is an error, never a silent value. docs/manifold-mls.md records every choice with its measurement.
+//! samples, or at a centre of curvature), is an error, never a silent value.
+//! docs/manifold-mls.md records every choice with its measurement.
 //!
 //! ```
 //! use umls_manifold::{ManifoldMls, PointCloud, Settings};

@@ -32,10 +32,11 @@ pub enum Bandwidth {
         /// σ over the K*-th neighbour distance.
         scale: f64,
     },
-    /// The [`Bandwidth::Neighbours`] rule's σ times one growth g for the whole cloud,
-    /// chosen when the approximation is built by leave-one-out cross-validation over
-    /// g = 1, 1.5, 2.25, … ≤ `max_growth`: on noisy data a wider neighbourhood averages
-    /// more noise, on clean data the rule's σ wins. See [`ManifoldMls::growth`].
+    /// The [`Bandwidth::Neighbours`] rule's σ times a growth g ∈ {1, 1.5, 2.25, …} ≤
+    /// `max_growth`, chosen by leave-one-out cross-validation when the approximation is
+    /// built: one g for clean data (the rule's σ wins), and on noisy data the g best over
+    /// the cross-validation samples nearest each query, since a wider neighbourhood
+    /// averages more noise. See [`ManifoldMls::growth`].
     Adaptive {
         /// c in K* = c · C(d+m, d) + 1.
         factor: f64,
@@ -70,15 +71,15 @@ impl Bandwidth {
     }
 }
 
-/// Samples left out, one at a time, to choose an adaptive bandwidth's growth.
 /// Largest polynomial basis C(d + m, d) a fit may have.
 const MAX_COEFFICIENTS: usize = 200;
 
 /// Samples of the cross-validation's first stage, which tells clean data from noisy.
 const SCREENING_SAMPLES: usize = 200;
 
-/// Samples of its second stage. 4,000: fewer leave the choice to chance, since the mean squared error being compared
-/// is 10–20 % of the noise variance that dominates each prediction's error.
+/// Samples of its second stage. 4,000: fewer leave the choice to chance, since the mean
+/// squared error being compared is 10–20 % of the noise variance that dominates each
+/// prediction's error.
 const CROSS_VALIDATION_SAMPLES: usize = 4000;
 
 /// Fraction of the left-out samples, the best predicted, whose errors are averaged: the
@@ -221,7 +222,7 @@ impl Concerns {
             ),
             (
                 self.unresolved,
-                "the residual is 3× the cloud's leave-one-out error",
+                "the residual is 4× the cloud's typical residual",
             ),
         ]
         .into_iter()
@@ -883,20 +884,29 @@ impl ManifoldMls {
         let mut hessian = DMatrix::<f64>::zeros(d, d);
         let mut total = 0.0;
         for c in 0..dim {
-            hessian.fill(0.0);
-            for &(j, a, b) in &self.second_order {
-                let coefficient = solution[j + (k + c) * rows] / (sigma * sigma);
-                if a == b {
-                    hessian[(a, a)] += 2.0 * coefficient;
-                } else {
-                    hessian[(a, b)] += coefficient;
-                    hessian[(b, a)] += coefficient;
-                }
-            }
+            self.second_order_hessian(
+                |j| solution[j + (k + c) * rows] / (sigma * sigma),
+                &mut hessian,
+            );
             let radius = spectral_radius(&hessian);
             total += radius * radius;
         }
         total.sqrt()
+    }
+
+    /// The Hessian of a polynomial in the basis, from its second-order coefficients
+    /// (`coefficient(j)` of monomial j, in physical units), written over `out`.
+    fn second_order_hessian(&self, coefficient: impl Fn(usize) -> f64, out: &mut DMatrix<f64>) {
+        out.fill(0.0);
+        for &(j, a, b) in &self.second_order {
+            let c = coefficient(j);
+            if a == b {
+                out[(a, a)] += 2.0 * c;
+            } else {
+                out[(a, b)] += c;
+                out[(b, a)] += c;
+            }
+        }
     }
 
     /// Refuses a query near a centre of curvature of the fitted manifold, where its
@@ -930,25 +940,16 @@ impl ManifoldMls {
         let normal: Vec<f64> = (0..dim).map(|i| (query[i] - foot[i]) / delta).collect();
         let largest = if self.settings.degree >= 2 {
             let mut shape = DMatrix::<f64>::zeros(d, d);
-            for (j, alpha) in self.monomials.exponents().iter().enumerate() {
-                if alpha.iter().sum::<u32>() != 2 {
-                    continue;
-                }
-                // ν · (coefficient of x^α) in physical units, then x^α's Hessian entries.
-                let c: f64 = (0..dim)
-                    .map(|i| normal[i] * solution[j + (k + i) * rows])
-                    .sum::<f64>()
-                    / (sigma * sigma);
-                let active: Vec<usize> = (0..d).filter(|&a| alpha[a] > 0).collect();
-                match active.as_slice() {
-                    [a] => shape[(*a, *a)] += 2.0 * c,
-                    [a, b] => {
-                        shape[(*a, *b)] += c;
-                        shape[(*b, *a)] += c;
-                    }
-                    _ => {}
-                }
-            }
+            // ν · (coefficient of x^α) in physical units.
+            self.second_order_hessian(
+                |j| {
+                    (0..dim)
+                        .map(|i| normal[i] * solution[j + (k + i) * rows])
+                        .sum::<f64>()
+                        / (sigma * sigma)
+                },
+                &mut shape,
+            );
             shape.symmetric_eigenvalues().max()
         } else {
             crate::dense::dot(&normal, &curvature_vector(frame, chart, mass, sigma, d))
