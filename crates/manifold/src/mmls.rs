@@ -411,8 +411,9 @@ impl ManifoldMls {
         Ok(mls)
     }
 
-    /// The factor by which every query's σ exceeds the neighbour rule's: chosen by
-    /// cross-validation for [`Bandwidth::Adaptive`], 1 otherwise.
+    /// The cloud's growth of the neighbour rule's σ: chosen by cross-validation for
+    /// [`Bandwidth::Adaptive`] (on noisy data each query then takes the growth best near
+    /// it), 1 otherwise.
     pub fn growth(&self) -> f64 {
         self.growth
     }
