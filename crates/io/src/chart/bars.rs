@@ -5,6 +5,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
+use super::legend::{self, Entry, Key};
 use super::{LEGEND_WIDTH, PALETTE, svg_string, write_svg};
 use crate::error::Result;
 
@@ -120,13 +121,16 @@ impl StackedBars {
                 start += length;
             }
         }
-        let entries: Vec<(String, RGBColor)> = self
+        let entries: Vec<Entry> = self
             .parts
             .iter()
             .enumerate()
-            .map(|(i, p)| (p.clone(), PALETTE[i % PALETTE.len()]))
+            .map(|(i, p)| Entry {
+                label: p.clone(),
+                key: Key::Swatch(PALETTE[i % PALETTE.len()]),
+            })
             .collect();
-        super::draw_legend(&legend, &entries, true)?;
+        legend::draw(&legend, &entries)?;
         root.present().map_err(|e| e.to_string())
     }
 }

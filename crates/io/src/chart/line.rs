@@ -1,10 +1,15 @@
-//! Line charts: curves over linear or logarithmic axes, with optional markers.
+//! Line charts: curves over linear or logarithmic axes, each in its style (colour,
+//! marker, dash), with failed runs marked; and figures of several such panels.
 
 use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{Axis, LEGEND_WIDTH, PALETTE, SIZE, Series, svg_string, write_svg};
+use plotters::coord::Shift;
+
+use super::legend::{self, Entry, Key};
+use super::style::{Style, draw_marker};
+use super::{Axis, LEGEND_WIDTH, SIZE, Series, svg_string, write_svg};
 use crate::error::Result;
 
 /// A line chart.
@@ -39,13 +44,21 @@ impl LineChart {
         })
     }
 
-    /// Data range of one coordinate, padded by 5 % (a factor on log axes).
-    fn range(&self, pick: fn(&(f64, f64)) -> f64, log: bool) -> (f64, f64) {
+    /// Data range of one coordinate, padded by 5 % (a factor on log axes); the
+    /// horizontal one includes the failed runs' positions.
+    fn range(&self, pick: fn(&(f64, f64)) -> f64, log: bool, with_failed: bool) -> (f64, f64) {
+        let failed = self
+            .series
+            .iter()
+            .filter(|_| with_failed)
+            .flat_map(|s| s.failed.iter().copied())
+            .filter(|&x| x.is_finite() && (!log || x > 0.0));
         let (lo, hi) = self
             .series
             .iter()
             .flat_map(|s| self.drawable(s))
             .map(|p| pick(&p))
+            .chain(failed)
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
                 (lo.min(v), hi.max(v))
             });
@@ -68,12 +81,43 @@ impl LineChart {
     fn draw<DB: DrawingBackend>(&self, backend: DB) -> std::result::Result<(), String> {
         let root = backend.into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let (plot_area, legend_area) = root.split_horizontally(SIZE.0 - LEGEND_WIDTH);
-        let (x0, x1) = self.range(|p| p.0, self.x.log);
-        let (y0, y1) = self.range(|p| p.1, self.y.log);
+        self.draw_on(&root, 24)?;
+        root.present().map_err(|e| e.to_string())
+    }
+
+    /// The style of each series: its own, or the first of [`Style::nth`] no other series
+    /// of the chart uses.
+    pub fn styles(&self) -> Vec<Style> {
+        let mut used: Vec<Style> = self.series.iter().filter_map(|s| s.style).collect();
+        let mut next = 0;
+        self.series
+            .iter()
+            .map(|s| {
+                s.style.unwrap_or_else(|| {
+                    while used.contains(&Style::nth(next)) {
+                        next += 1;
+                    }
+                    used.push(Style::nth(next));
+                    Style::nth(next)
+                })
+            })
+            .collect()
+    }
+
+    /// Draws the chart, its legend on the right, into `area`.
+    fn draw_on<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        caption: u32,
+    ) -> std::result::Result<(), String> {
+        let (width, _) = area.dim_in_pixel();
+        let (plot_area, legend_area) = area.split_horizontally(width - LEGEND_WIDTH);
+        let (x0, x1) = self.range(|p| p.0, self.x.log, true);
+        let (y0, y1) = self.range(|p| p.1, self.y.log, false);
+        let styles = self.styles();
         let mut builder = ChartBuilder::on(&plot_area);
         builder
-            .caption(&self.title, ("sans-serif", 24))
+            .caption(&self.title, ("sans-serif", caption))
             .margin(14)
             .x_label_area_size(55)
             .y_label_area_size(90);
@@ -95,22 +139,35 @@ impl LineChart {
                     .y_label_formatter(&|v| tick_label(*v, self.y.log))
                     .draw()
                     .map_err(|e| e.to_string())?;
-                for (i, series) in self.series.iter().enumerate() {
-                    let colour = PALETTE[i % PALETTE.len()];
-                    chart
-                        .draw_series(LineSeries::new(
-                            self.drawable(series),
-                            colour.stroke_width(2),
-                        ))
-                        .map_err(|e| e.to_string())?;
-                    if series.markers {
-                        chart
-                            .draw_series(
-                                self.drawable(series)
-                                    .map(|p| Circle::new(p, 4, colour.filled())),
-                            )
-                            .map_err(|e| e.to_string())?;
+                for (series, style) in self.series.iter().zip(&styles) {
+                    let colour = style.rgb();
+                    let stroke = colour.stroke_width(2);
+                    match style.dash.pattern() {
+                        None => chart
+                            .draw_series(LineSeries::new(self.drawable(series), stroke))
+                            .map(|_| ()),
+                        Some((dash, gap)) => chart
+                            .draw_series(DashedLineSeries::new(
+                                self.drawable(series).collect::<Vec<_>>(),
+                                dash,
+                                gap,
+                                stroke,
+                            ))
+                            .map(|_| ()),
                     }
+                    .map_err(|e| e.to_string())?;
+                    if series.markers {
+                        for p in self.drawable(series) {
+                            draw_marker(chart.plotting_area(), style.marker, p, 10, colour)?;
+                        }
+                    }
+                    // A failed run has no value: a cross on the bottom of the plot.
+                    let failed = series
+                        .failed
+                        .iter()
+                        .filter(|&&x| x.is_finite() && (!self.x.log || x > 0.0))
+                        .map(|&x| Cross::new((x, y0), 7, colour.stroke_width(3)));
+                    chart.draw_series(failed).map_err(|e| e.to_string())?;
                 }
             }};
         }
@@ -129,14 +186,64 @@ impl LineChart {
                 (y0..y1).log_scale().with_key_points(log_ticks(y0, y1))
             ),
         }
-        let entries: Vec<(String, RGBColor)> = self
+        let entries: Vec<Entry> = self
             .series
             .iter()
-            .enumerate()
-            .map(|(i, s)| (s.label.clone(), PALETTE[i % PALETTE.len()]))
+            .zip(&styles)
+            .map(|(s, &style)| Entry {
+                label: s.legend_label(),
+                key: Key::Line(style, s.markers),
+            })
             .collect();
-        super::draw_legend(&legend_area, &entries, false)?;
-        root.present().map_err(|e| e.to_string())
+        legend::draw(&legend_area, &entries)
+    }
+}
+
+/// Line charts stacked top to bottom as the panels of one figure under one title: a
+/// comparison with more curves than one panel can show, split by a facet (the transfer,
+/// a variant, a family of methods).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PanelChart {
+    /// Title above the panels.
+    pub title: String,
+    /// The panels; each one's title names its facet.
+    pub panels: Vec<LineChart>,
+}
+
+/// Height of one panel of a [`PanelChart`].
+const PANEL_HEIGHT: u32 = 520;
+/// Height of a [`PanelChart`]'s title.
+const TITLE_HEIGHT: u32 = 50;
+
+impl PanelChart {
+    /// Figure size: the width of a line chart, one panel height per panel.
+    pub fn size(&self) -> (u32, u32) {
+        (
+            SIZE.0,
+            TITLE_HEIGHT + PANEL_HEIGHT * self.panels.len().max(1) as u32,
+        )
+    }
+
+    /// The figure as an SVG document.
+    pub fn to_svg(&self) -> Result<String> {
+        svg_string(self.size(), |backend| {
+            let root = backend.into_drawing_area();
+            root.fill(&WHITE).map_err(|e| e.to_string())?;
+            let (title, body) = root.split_vertically(TITLE_HEIGHT);
+            title
+                .titled(&self.title, ("sans-serif", 24))
+                .map_err(|e| e.to_string())?;
+            let areas = body.split_evenly((self.panels.len().max(1), 1));
+            for (panel, area) in self.panels.iter().zip(&areas) {
+                panel.draw_on(area, 20)?;
+            }
+            root.present().map_err(|e| e.to_string())
+        })
+    }
+
+    /// Writes the figure to `path` as SVG.
+    pub fn write_svg(&self, path: &Path) -> Result<()> {
+        write_svg(path, self.to_svg())
     }
 }
 
@@ -213,7 +320,7 @@ mod tests {
             ],
         };
         assert_eq!(chart.drawable(&chart.series[0]).count(), 2);
-        let (lo, hi) = chart.range(|p| p.1, true);
+        let (lo, hi) = chart.range(|p| p.1, true, false);
         assert!(
             lo < 1e-6 && lo > 1e-7 && hi > 1e-3 && hi < 1e-2,
             "{lo} {hi}"

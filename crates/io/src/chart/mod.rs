@@ -1,11 +1,15 @@
 //! Charts as SVG files a browser opens: one module for every chart the project draws,
 //! so they all read the same way — a title, axis labels with units, tick labels
 //! large enough to read, optional logarithmic axes for data spanning decades, and the
-//! legend in a panel beside the plot where it cannot cover a curve. Non-finite points
+//! legend in a panel beside the plot where it cannot cover a curve, its lines wrapped and
+//! its font shrunk until it fits the canvas. Non-finite points
 //! (and non-positive ones on a log axis) are left out rather than allowed to break the
 //! axis ranges.
 //!
-//! - [`LineChart`]: curves (energies, convergence, error against time);
+//! - [`LineChart`]: curves (energies, convergence, error against time), each in a
+//!   [`Style`] of its own; failed runs are crosses on the bottom axis;
+//! - [`PanelChart`]: line charts stacked as panels of one figure, for comparisons with
+//!   more curves than one panel can show;
 //! - [`StatusMap`]: a grid of outcomes over two parameters, one panel per method
 //!   (stability maps);
 //! - [`StackedBars`]: horizontal bars split into parts (time per step by stage).
@@ -31,19 +35,22 @@ use plotters::prelude::*;
 use crate::error::{IoError, Result};
 
 mod bars;
+mod legend;
 mod line;
 mod status_map;
+mod style;
 
 pub use bars::{Bar, StackedBars};
-pub use line::LineChart;
+pub use line::{LineChart, PanelChart};
 pub use status_map::{MapCell, MapPanel, Outcome, StatusMap};
+pub use style::{COLOURS, Dash, Marker, Style};
 
 /// Width and height of a chart in pixels.
 const SIZE: (u32, u32) = (1100, 600);
 /// Width of the legend panel on the right.
-const LEGEND_WIDTH: u32 = 230;
+const LEGEND_WIDTH: u32 = 260;
 
-/// Colours cycled through the series: distinguishable, and readable on white.
+/// Colours of the parts of bars and of unstyled legend swatches.
 const PALETTE: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
@@ -54,6 +61,10 @@ const PALETTE: [RGBColor; 8] = [
     RGBColor(23, 190, 207),
     RGBColor(140, 86, 75),
 ];
+
+/// Width of one character of the sans-serif font in units of the font size, generous so
+/// that a wrapped legend line is never wider than measured.
+pub const CHAR_WIDTH: f64 = 0.6;
 
 /// One axis: its label (with the unit in brackets) and its scale.
 #[derive(Debug, Clone, PartialEq)]
@@ -91,6 +102,13 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Draw markers at the points as well as the line (for few points).
     pub markers: bool,
+    /// Its look; `None` takes [`Style::nth`] of its place in the chart.
+    pub style: Option<Style>,
+    /// Horizontal positions of runs that failed and have no value: drawn as crosses on
+    /// the bottom of the plot, and counted in the legend.
+    pub failed: Vec<f64>,
+    /// Runs that failed, including those without a horizontal position.
+    pub failed_count: usize,
 }
 
 impl Series {
@@ -100,6 +118,30 @@ impl Series {
             label: label.into(),
             points,
             markers: false,
+            style: None,
+            failed: Vec::new(),
+            failed_count: 0,
+        }
+    }
+
+    /// The same series in `style`.
+    pub fn with_style(mut self, style: Style) -> Self {
+        self.style = Some(style);
+        self
+    }
+
+    /// The same series with `count` failed runs, of which those at `positions` are drawn.
+    pub fn with_failures(mut self, positions: Vec<f64>, count: usize) -> Self {
+        self.failed_count = count.max(positions.len());
+        self.failed = positions;
+        self
+    }
+
+    /// Its legend text: the label, and the failed runs' count.
+    pub fn legend_label(&self) -> String {
+        match self.failed_count {
+            0 => self.label.clone(),
+            n => format!("{} (✗ {n} failed)", self.label),
         }
     }
 
@@ -133,31 +175,4 @@ fn write_svg(path: &Path, svg: Result<String>) -> Result<()> {
         other => other,
     })?;
     crate::write_file(path, svg.as_bytes())
-}
-
-/// Draws the legend entries `(label, colour)` as swatches down a panel.
-fn draw_legend<DB: DrawingBackend>(
-    area: &DrawingArea<DB, plotters::coord::Shift>,
-    entries: &[(String, RGBColor)],
-    swatch: bool,
-) -> std::result::Result<(), String> {
-    for (i, (label, colour)) in entries.iter().enumerate() {
-        let y = 70 + 30 * i as i32;
-        if swatch {
-            area.draw(&Rectangle::new([(10, y - 9), (40, y + 9)], colour.filled()))
-        } else {
-            area.draw(&PathElement::new(
-                vec![(10, y), (40, y)],
-                colour.stroke_width(3),
-            ))
-        }
-        .map_err(|e| e.to_string())?;
-        area.draw(&Text::new(
-            label.clone(),
-            (48, y - 9),
-            ("sans-serif", 17).into_font(),
-        ))
-        .map_err(|e| e.to_string())?;
-    }
-    Ok(())
 }

@@ -1,11 +1,13 @@
 //! Stability maps: for each method a panel, a grid over two parameters (time step ×
 //! mesh jitter, say), each cell coloured by how the run ended and labelled with a short
-//! note (the failure kind, or the energy change).
+//! note (the failure kind, or the energy change), and a heavy line where failed cells
+//! meet cells that ran to the end: the method's failure boundary.
 
 use std::path::Path;
 
 use plotters::prelude::*;
 
+use super::legend::{self, Entry, Key};
 use super::{LEGEND_WIDTH, svg_string, write_svg};
 use crate::error::Result;
 
@@ -130,11 +132,14 @@ impl StatusMap {
         for (panel, area) in self.panels.iter().zip(&areas) {
             self.draw_panel(panel, area)?;
         }
-        let entries: Vec<(String, RGBColor)> = Outcome::ALL
+        let entries: Vec<Entry> = Outcome::ALL
             .iter()
-            .map(|o| (o.label().to_string(), o.colour()))
+            .map(|o| Entry {
+                label: o.label().to_string(),
+                key: Key::Swatch(o.colour()),
+            })
             .collect();
-        super::draw_legend(&legend, &entries, true)?;
+        legend::draw(&legend, &entries)?;
         root.present().map_err(|e| e.to_string())
     }
 
@@ -192,6 +197,31 @@ impl StatusMap {
                 .plotting_area()
                 .draw(&rectangle)
                 .map_err(|e| e.to_string())?;
+            // The failure boundary: a heavy line on every side a failed cell shares with
+            // a cell that ran to the end, so the region where the method fails reads at a
+            // glance.
+            if outcome == Outcome::Failed {
+                let ran = |cx: isize, cy: isize| {
+                    (0..nx as isize).contains(&cx)
+                        && (0..ny as isize).contains(&cy)
+                        && grid[cy as usize * nx + cx as usize].is_some_and(|c| {
+                            matches!(c.outcome, Outcome::Completed | Outcome::EnergyGrowth)
+                        })
+                };
+                let (xi, yi) = (x as isize, y as isize);
+                let sides = [
+                    (ran(xi - 1, yi), [corner(0, 0), corner(0, 1)]),
+                    (ran(xi + 1, yi), [corner(1, 0), corner(1, 1)]),
+                    (ran(xi, yi - 1), [corner(0, 0), corner(1, 0)]),
+                    (ran(xi, yi + 1), [corner(0, 1), corner(1, 1)]),
+                ];
+                for (_, side) in sides.iter().filter(|(on, _)| *on) {
+                    chart
+                        .plotting_area()
+                        .draw(&PathElement::new(side.to_vec(), BLACK.stroke_width(4)))
+                        .map_err(|e| e.to_string())?;
+                }
+            }
             if let Some(cell) = cell.filter(|c| !c.note.is_empty()) {
                 let style = ("sans-serif", 14).into_font().color(&BLACK).pos(
                     plotters::style::text_anchor::Pos::new(
@@ -273,5 +303,18 @@ mod tests {
         assert_eq!(svg.matches(&fill(Outcome::Failed)).count(), 2);
         assert_eq!(svg.matches(&fill(Outcome::Completed)).count(), 2);
         assert_eq!(svg.matches(&fill(Outcome::Missing)).count(), 2 + 4 + 1);
+        // The failed cell (1, 1) borders no completed cell (its neighbours were not run):
+        // no boundary. A failed cell beside a completed one gets one heavy side.
+        assert_eq!(svg.matches("stroke-width=\"4\"").count(), 0);
+        let mut beside = map.clone();
+        beside.panels[0].cells.push(MapCell {
+            x: 1,
+            y: 0,
+            outcome: Outcome::Failed,
+            note: "kick".into(),
+        });
+        let svg = beside.to_svg().unwrap();
+        // (1, 0) borders (0, 0) on its left; (1, 1) above it is failed too.
+        assert_eq!(svg.matches("stroke-width=\"4\"").count(), 1);
     }
 }
