@@ -949,7 +949,7 @@ fn bad_values_fail_fast_and_name_their_key() {
             "jitter",
             edit("jitter = 0.2", "jitter = 0.5"),
             &[],
-            &["jitter", "[0, 0.2]"],
+            &["jitter", "[0, 0.45]"],
             &["MAX_JITTER"],
         ),
         ("directory", None, &[], &["is a directory"], &[]),

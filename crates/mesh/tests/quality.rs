@@ -268,3 +268,60 @@ fn mean_element_size_of_a_lattice_is_its_cell_size_under_jitter() {
         }
     }
 }
+
+/// In 2D the jitter reaches slivers: at 0.45 of the cell every split but the crossed one
+/// builds for many seeds, every triangle keeps a positive area (the mesh is built
+/// rejecting inverted simplices), and triangles with an angle near 180° appear. Up to the
+/// 3D bound no cell takes the other diagonal, so those meshes are the plain splits.
+#[test]
+fn planar_jitter_reaches_slivers_without_inverting_a_triangle() {
+    let mut widest = 0.0f64;
+    for seed in 0..40 {
+        for diagonal in [Diagonal::Alternating, Diagonal::Right, Diagonal::Left] {
+            let lattice = Lattice::new([0.0, 0.0], [1.0, 1.0], [12, 12]).jitter(0.45, seed);
+            let mesh = lattice
+                .triangles(diagonal)
+                .unwrap_or_else(|e| panic!("seed {seed}, {diagonal:?}: {e}"));
+            assert_eq!(mesh.simplex_count(), 2 * 144);
+            for s in 0..mesh.simplex_count() {
+                widest = widest.max(mesh.simplex_quality(s).max_angle.unwrap());
+            }
+        }
+        // At 0.2 the chosen diagonal is kept in every cell: the first triangle of cell 0
+        // of the right split is (v00, v10, v11).
+        let mild = Lattice::new([0.0, 0.0], [1.0, 1.0], [12, 12]).jitter(0.2, seed);
+        let right = mild.triangles(Diagonal::Right).unwrap();
+        let plain = Lattice::new([0.0, 0.0], [1.0, 1.0], [12, 12])
+            .triangles(Diagonal::Right)
+            .unwrap();
+        for s in 0..right.simplex_count() {
+            let mut a = right.simplex(s).to_vec();
+            let mut b = plain.simplex(s).to_vec();
+            a.sort_unstable();
+            b.sort_unstable();
+            assert_eq!(
+                a, b,
+                "seed {seed}: cell of simplex {s} changed its diagonal at 0.2"
+            );
+        }
+    }
+    assert!(
+        widest > 170f64.to_radians(),
+        "widest angle {}°",
+        widest.to_degrees()
+    );
+    // Beyond ½ a cell can fold: refused, naming the parameter and the 2D bound.
+    let err = Lattice::new([0.0, 0.0], [1.0, 1.0], [4, 4])
+        .jitter(0.5, 1)
+        .triangles(Diagonal::Right)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("jitter") && err.contains("0.45"), "{err}");
+    // 3D keeps its bound.
+    let err = Lattice::new([0.0; 3], [1.0; 3], [2; 3])
+        .jitter(0.3, 1)
+        .tetrahedra()
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("0.2"), "{err}");
+}

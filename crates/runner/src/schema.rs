@@ -162,7 +162,7 @@ pub struct LatticeSpec {
     pub upper: Vec<f64>,
     /// Cells per axis.
     pub cells: Vec<usize>,
-    /// Interior vertex jitter as a fraction of the cell size (0 to 0.2).
+    /// Interior vertex jitter as a fraction of the cell size (0 to 0.45 in 2D, 0.2 in 3D).
     #[serde(default)]
     pub jitter: f64,
     /// Seed of the jitter.

@@ -53,8 +53,18 @@ impl Spacing {
 /// in the displacements: in 2·10⁴ random 4³ lattices per amplitude, inverted tetrahedra
 /// appeared from a = 0.23 (none at 0.22; none in 2D up to 0.249). 0.2 keeps a margin;
 /// should a lattice still invert a simplex, the generator returns
-/// [`crate::MeshError::InvertedSimplex`] naming it, never a broken mesh.
+/// [`crate::MeshError::InvertedSimplex`] naming it, never a broken mesh. This bound is
+/// the 3D one; 1D and 2D lattices take up to [`MAX_JITTER_PLANAR`].
 pub const MAX_JITTER: f64 = 0.2;
+
+/// Largest accepted jitter amplitude of a 1D or 2D lattice. Below ½ the vertices of one
+/// row (column) stay in a band of their own, so every jittered cell is a simple polygon:
+/// a segment keeps its direction, and a quadrilateral, convex or not, always has a
+/// diagonal inside it, which [`Lattice::triangles`] takes where the chosen one would
+/// invert a triangle. 0.45 reaches slivers (triangles with an angle near 180°) for
+/// stability studies; the crossed split, whose centre vertex may fall outside a
+/// non-convex cell, can still be refused with [`crate::MeshError::InvertedSimplex`].
+pub const MAX_JITTER_PLANAR: f64 = 0.45;
 
 /// A D-dimensional lattice of `cells[k] + 1` vertices per axis over the box `[lower, upper]`.
 ///
@@ -93,8 +103,8 @@ impl<const D: usize> Lattice<D> {
         self
     }
 
-    /// Jitters interior vertices by up to `amount` (≤ [`MAX_JITTER`]) times the local cell
-    /// width per axis, reproducibly from `seed`.
+    /// Jitters interior vertices by up to `amount` (≤ [`Lattice::max_jitter`]) times the
+    /// local cell width per axis, reproducibly from `seed`.
     pub fn jitter(mut self, amount: f64, seed: u64) -> Self {
         self.jitter = amount;
         self.seed = seed;
@@ -105,6 +115,16 @@ impl<const D: usize> Lattice<D> {
     pub fn rotate(mut self, rotation: SMatrix<f64, D, D>) -> Self {
         self.rotation = rotation;
         self
+    }
+
+    /// The largest jitter this dimension accepts: [`MAX_JITTER_PLANAR`] in 1D and 2D,
+    /// [`MAX_JITTER`] in 3D.
+    pub fn max_jitter() -> f64 {
+        if D <= 2 {
+            MAX_JITTER_PLANAR
+        } else {
+            MAX_JITTER
+        }
     }
 
     /// Number of vertices.
@@ -122,7 +142,7 @@ impl<const D: usize> Lattice<D> {
     }
 
     /// Checks the parameters as the generators do before building: cells, bounds,
-    /// spacing ratios, jitter (≤ [`MAX_JITTER`]) and rotation. For a caller that uses the
+    /// spacing ratios, jitter (≤ [`Lattice::max_jitter`]) and rotation. For a caller that uses the
     /// lattice's box without building its simplices, so that it refuses what they refuse.
     pub fn validate(&self) -> Result<(), MeshError> {
         let bad = |parameter, value: String, reason| {
@@ -160,11 +180,15 @@ impl<const D: usize> Lattice<D> {
                 }
             }
         }
-        if !(0.0..=MAX_JITTER).contains(&self.jitter) {
+        if !(0.0..=Self::max_jitter()).contains(&self.jitter) {
             return bad(
                 "jitter",
                 self.jitter.to_string(),
-                "must lie in [0, 0.2] (a fraction of the cell width; more can invert cells)",
+                if D <= 2 {
+                    "must lie in [0, 0.45] in 1D and 2D (a fraction of the cell width; ½ folds cells)"
+                } else {
+                    "must lie in [0, 0.2] in 3D (a fraction of the cell width; more can invert cells)"
+                },
             );
         }
         let r = &self.rotation;

@@ -8,5 +8,5 @@ mod lattice;
 mod rng;
 mod split;
 
-pub use lattice::{Lattice, MAX_JITTER, Spacing};
+pub use lattice::{Lattice, MAX_JITTER, MAX_JITTER_PLANAR, Spacing};
 pub use split::Diagonal;

@@ -56,7 +56,8 @@ impl Lattice<1> {
 }
 
 impl Lattice<2> {
-    /// Triangles, split per `diagonal`.
+    /// Triangles, split per `diagonal`; a jittered cell whose chosen diagonal would invert
+    /// a triangle takes the other one.
     pub fn triangles(&self, diagonal: Diagonal) -> Result<SimplexMesh<2>, MeshError> {
         let reference = self.reference_coordinates()?;
         let mut coordinates = self.coordinates(&reference);
@@ -87,10 +88,20 @@ impl Lattice<2> {
                     continue;
                 }
             };
-            if right {
-                connectivity.extend([v00, v10, v11, v00, v11, v01]);
+            // A jittered cell is a simple quadrilateral (the jitter stays below ½), so one
+            // diagonal at least lies inside it: keep the chosen one unless it would invert a
+            // triangle. Up to the 3D bound no cell flips, so those meshes are unchanged.
+            let positive = |t: [u32; 3]| signed_volume(&t.map(|v| coordinates[v as usize])) > 0.0;
+            let along_right = [[v00, v10, v11], [v00, v11, v01]];
+            let along_left = [[v00, v10, v01], [v10, v11, v01]];
+            let (chosen, other) = if right {
+                (along_right, along_left)
             } else {
-                connectivity.extend([v00, v10, v01, v10, v11, v01]);
+                (along_left, along_right)
+            };
+            let keep = chosen.iter().all(|&t| positive(t)) || !other.iter().all(|&t| positive(t));
+            for triangle in if keep { chosen } else { other } {
+                connectivity.extend(triangle);
             }
         }
         self.assemble(reference, coordinates, &reference_centres, connectivity)
