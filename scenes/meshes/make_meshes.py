@@ -91,6 +91,39 @@ def column_3d():
     box_of_tetrahedra(0.2, (1.0, 1.0, 4.4), "box")
 
 
+def bowl(size):
+    """The curved container of `fluid-bowl.toml`: the disk of radius 1 about the origin
+    cut at y = 0.3, triangles of `size`; physical groups "wall" (the arc) and "inside".
+    The fluid fills it to y = 0."""
+    disk = gmsh.model.occ.addDisk(0, 0, 0, 1.0, 1.0)
+    cut = gmsh.model.occ.addRectangle(-1.5, -1.5, 0, 3.0, 1.8)
+    (inside,), _ = gmsh.model.occ.intersect([(2, disk)], [(2, cut)])
+    gmsh.model.occ.synchronize()
+    gmsh.model.mesh.setSize(gmsh.model.getEntities(0), size)
+    arc = [c for _, c in gmsh.model.getBoundary([inside], oriented=False)
+           if gmsh.model.occ.getCenterOfMass(1, c)[1] < 0.29]
+    gmsh.model.addPhysicalGroup(1, arc, name="wall")
+    gmsh.model.addPhysicalGroup(2, [inside[1]], name="inside")
+    gmsh.model.mesh.generate(2)
+
+
+def bowl_3d(size):
+    """The 3D curved container of `fluid-bowl-3d.toml`: the ball of radius 1 cut at
+    z = 0.3, tetrahedra of `size`; physical groups "wall" (the spherical surface) and
+    "inside". The fluid fills it to z = 0."""
+    ball = gmsh.model.occ.addSphere(0, 0, 0, 1.0)
+    cut = gmsh.model.occ.addBox(-1.5, -1.5, -1.5, 3.0, 3.0, 1.8)
+    (inside,), _ = gmsh.model.occ.intersect([(3, ball)], [(3, cut)])
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMin", size)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+    wall = [c for _, c in gmsh.model.getBoundary([inside], oriented=False)
+            if gmsh.model.occ.getCenterOfMass(2, c)[2] < 0.29]
+    gmsh.model.addPhysicalGroup(2, wall, name="wall")
+    gmsh.model.addPhysicalGroup(3, [inside[1]], name="inside")
+    gmsh.model.mesh.generate(3)
+
+
 if "--cantilever-refined" in sys.argv:
     for factor in (2, 3, 5):
         mesh(f"cantilever-room-h{factor}", lambda: cantilever_room(0.25 / factor))
@@ -102,3 +135,8 @@ mesh("sphere-container", sphere_container, binary=True)
 mesh("slope-box", slope_box, binary=True)
 mesh("column", column)
 mesh("column-3d", column_3d, binary=True)
+# The curved containers at two sizes each: the report's levels 1 and 2.
+mesh("bowl", lambda: bowl(0.1))
+mesh("bowl-h2", lambda: bowl(0.05))
+mesh("bowl-3d", lambda: bowl_3d(0.2), binary=True)
+mesh("bowl-3d-h2", lambda: bowl_3d(0.1), binary=True)

@@ -5,7 +5,8 @@
 //! The engine's materials are functions of the deformation gradient, so an initial stress
 //! is imposed as an initial elastic pre-strain: for each particle the symmetric stretch U
 //! with σ(U) = σ₀ is found by Newton's method (finite-difference Jacobian, at most
-//! D(D+1)/2 = 6 unknowns), which works for every [`Constitutive`] model and keeps
+//! D(D+1)/2 = 6 unknowns, least-squares steps so that a fluid's pressure is reached
+//! although it resists no shear), which works for every [`Constitutive`] model and keeps
 //! stress, energy and plasticity consistent with each other.
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
@@ -119,7 +120,12 @@ pub fn prestrain<const D: usize, M: Constitutive<D>>(
             let column = (residual(&plus)? - residual(&minus)?) / (2.0 * step);
             jacobian.set_column(k, &column);
         }
-        let delta = jacobian.lu().solve(&r)?;
+        // The least-squares step of smallest norm: a fluid has no stiffness against
+        // shear, so its Jacobian is singular in the deviatoric directions, and the
+        // pseudo-inverse leaves them alone while it solves the volumetric one.
+        let svd = jacobian.svd(true, true);
+        let cutoff = 1e-10 * svd.singular_values.max();
+        let delta = svd.solve(&r, cutoff).ok()?;
         u -= delta;
     }
     None
@@ -128,7 +134,9 @@ pub fn prestrain<const D: usize, M: Constitutive<D>>(
 #[cfg(test)]
 mod tests {
     use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
-    use umls_constitutive::{ElasticParameters, FixedCorotated, LinearElastic, NeoHookean};
+    use umls_constitutive::{
+        ElasticParameters, FixedCorotated, LinearElastic, NeoHookean, WeaklyCompressibleFluid,
+    };
 
     use super::*;
 
@@ -155,5 +163,23 @@ mod tests {
         assert!(u[(0, 2)].abs() > 0.0 && (u - u.transpose()).amax() == 0.0);
         let sigma: Matrix3<f64> = model.cauchy_stress(&u, &()).unwrap();
         assert!((sigma - target).amax() < 1e-9 * target.amax());
+    }
+
+    /// A fluid resists no shear, so its Jacobian is singular: the hydrostatic pressure
+    /// (K0 = 1) is still reached, by an isotropic stretch with p(J) = ρ g d, and a
+    /// deviatoric stress (K0 ≠ 1), which a fluid cannot carry, is refused.
+    #[test]
+    fn a_fluid_reaches_its_pressure_and_refuses_shear() {
+        let fluid = WeaklyCompressibleFluid::new(1e7, 1.0).unwrap();
+        for g in [Vector3::new(0.0, 0.0, -10.0), Vector3::new(2.0, 1.0, -9.0)] {
+            let target = geostatic_stress(&g, 1000.0, 0.8, 1.0);
+            let u = prestrain(&fluid, &(), &target).unwrap();
+            let sigma: Matrix3<f64> = fluid.cauchy_stress(&u, &()).unwrap();
+            assert!((sigma - target).amax() < 1e-9 * target.amax());
+            let j = u.determinant();
+            assert!((fluid.pressure(j) - 1000.0 * g.norm() * 0.8).abs() < 1e-6);
+        }
+        let sheared = geostatic_stress(&Vector2::new(0.0, -10.0), 1000.0, 0.8, 0.5);
+        assert!(prestrain(&fluid, &(), &sheared).is_none());
     }
 }

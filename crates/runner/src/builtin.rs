@@ -13,7 +13,7 @@ pub struct Builtin {
 }
 
 /// Every built-in scene.
-pub const BUILTIN: [Builtin; 15] = [
+pub const BUILTIN: [Builtin; 17] = [
     Builtin {
         name: "colliding-disks",
         summary: "two elastic disks collide and rebound (Sulsky et al. 1994) on a jittered triangle mesh",
@@ -89,11 +89,21 @@ pub const BUILTIN: [Builtin; 15] = [
         summary: "a 45° Drucker–Prager slope collapses and runs out on a fixed floor (Gmsh tetrahedra)",
         toml: include_str!("../../../scenes/slope-3d.toml"),
     },
+    Builtin {
+        name: "fluid-bowl",
+        summary: "a fluid at rest in a curved container the mesh conforms to, against the hydrostatic pressure (Gmsh triangles)",
+        toml: include_str!("../../../scenes/fluid-bowl.toml"),
+    },
+    Builtin {
+        name: "fluid-bowl-3d",
+        summary: "the fluid at rest in a 3D curved container (Gmsh tetrahedra), against the hydrostatic pressure",
+        toml: include_str!("../../../scenes/fluid-bowl-3d.toml"),
+    },
 ];
 
 /// Files the built-in scenes refer to (meshes, reference data), by the name the scene
 /// uses.
-pub const FILES: [(&str, &[u8]); 8] = [
+pub const FILES: [(&str, &[u8]); 12] = [
     (
         "meshes/cantilever.msh",
         include_bytes!("../../../scenes/meshes/cantilever.msh"),
@@ -117,6 +127,22 @@ pub const FILES: [(&str, &[u8]); 8] = [
     (
         "meshes/column-3d.msh",
         include_bytes!("../../../scenes/meshes/column-3d.msh"),
+    ),
+    (
+        "meshes/bowl.msh",
+        include_bytes!("../../../scenes/meshes/bowl.msh"),
+    ),
+    (
+        "meshes/bowl-h2.msh",
+        include_bytes!("../../../scenes/meshes/bowl-h2.msh"),
+    ),
+    (
+        "meshes/bowl-3d.msh",
+        include_bytes!("../../../scenes/meshes/bowl-3d.msh"),
+    ),
+    (
+        "meshes/bowl-3d-h2.msh",
+        include_bytes!("../../../scenes/meshes/bowl-3d-h2.msh"),
     ),
     (
         "data/cantilever-tip.csv",

@@ -1,5 +1,6 @@
 //! `[reference.hydrostatic]`: the closed-form state of a laterally confined elastic column
-//! at rest under gravity, and the metrics of a run against it.
+//! at rest under gravity, or of a fluid at rest in a container of any shape, and the
+//! metrics of a run against it.
 //!
 //! With slip walls and a slip base the column is in uniaxial strain, so at depth d below
 //! the free surface (scene frame, "up" = −g)
@@ -8,6 +9,9 @@
 //! - the downward displacement at depth d is ρ g (H² − d²) / (2M), M = E(1 − ν) /
 //!   ((1 + ν)(1 − 2ν)) the constrained (P-wave) modulus, so the surface settles by
 //!   ρ g H² / (2M).
+//!
+//! A fluid at rest carries the pressure ρ g d in any container: σ = −ρ g d I, K0 = 1, and
+//! no settlement metric (it depends on the container's shape).
 //!
 //! The metrics compare each particle, by its initial position, with these at the end of
 //! the run (the scene brings the column to rest by damping or a gravity ramp).
@@ -32,10 +36,11 @@ pub struct Hydrostatic<const D: usize> {
     row: f64,
     /// ρ g.
     unit_weight: f64,
-    /// K0 = ν / (1 − ν).
+    /// K0 = ν / (1 − ν) for an elastic column, 1 for a fluid.
     k0: f64,
-    /// Constrained modulus M.
-    modulus: f64,
+    /// Constrained modulus M of an elastic column (none for a fluid, whose settlement
+    /// depends on its container).
+    modulus: Option<f64>,
 }
 
 /// Which particles a metric averages over.
@@ -108,28 +113,38 @@ impl<const D: usize> Hydrostatic<D> {
                 ));
             }
         };
-        let solid = match &scene.spec.materials[usize::from(material)] {
+        // An elastic column is in uniaxial strain: K0 = ν/(1 − ν), constrained modulus M.
+        // A fluid at rest is in hydrostatic pressure in any container: K0 = 1; its
+        // settlement depends on the container's shape, so it has none.
+        let (density, k0, modulus) = match &scene.spec.materials[usize::from(material)] {
             MaterialSpec::LinearElastic(s)
             | MaterialSpec::NeoHookean(s)
             | MaterialSpec::StVenantKirchhoff(s)
-            | MaterialSpec::FixedCorotated(s) => s,
+            | MaterialSpec::FixedCorotated(s) => {
+                let nu = s.poisson;
+                (
+                    s.density,
+                    nu / (1.0 - nu),
+                    Some(s.young * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))),
+                )
+            }
+            MaterialSpec::Fluid(f) => (f.density, 1.0, None),
             _ => {
                 return Err(scene.value_error(
                     "reference.hydrostatic",
-                    "the column's material must be elastic (its closed form is elastic)",
+                    "the body's material must be elastic or a fluid (the closed form is theirs)",
                 ));
             }
         };
-        let nu = solid.poisson;
         let column = Self {
             up,
             surface: spec.surface,
             height,
             margin,
             row,
-            unit_weight: solid.density * gravity.norm(),
-            k0: nu / (1.0 - nu),
-            modulus: solid.young * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+            unit_weight: density * gravity.norm(),
+            k0,
+            modulus,
         };
         for (band, name) in [
             (Band::Interior, "margin"),
@@ -191,10 +206,10 @@ impl<const D: usize> Hydrostatic<D> {
                 bottom += vv;
                 bottom_exact += exact;
             }
-            if self.in_band(Band::TopRow, &xs) {
+            if let (Some(modulus), true) = (self.modulus, self.in_band(Band::TopRow, &xs)) {
                 settled += (x0 - x).dot(&up_world);
                 settled_exact +=
-                    self.unit_weight * (self.height * self.height - d * d) / (2.0 * self.modulus);
+                    self.unit_weight * (self.height * self.height - d * d) / (2.0 * modulus);
                 top += 1;
             }
         }
@@ -208,12 +223,14 @@ impl<const D: usize> Hydrostatic<D> {
         m.insert("bottom_row_ratio".into(), json!(bottom / bottom_exact));
         m.insert("k0".into(), json!(horizontal / vertical));
         m.insert("k0_exact".into(), json!(self.k0));
-        m.insert("settlement".into(), json!(settled / top.max(1) as f64));
-        m.insert(
-            "settlement_exact".into(),
-            json!(scale * self.height / (2.0 * self.modulus)),
-        );
-        m.insert("settlement_ratio".into(), json!(settled / settled_exact));
+        if let Some(modulus) = self.modulus {
+            m.insert("settlement".into(), json!(settled / top.max(1) as f64));
+            m.insert(
+                "settlement_exact".into(),
+                json!(scale * self.height / (2.0 * modulus)),
+            );
+            m.insert("settlement_ratio".into(), json!(settled / settled_exact));
+        }
         m
     }
 }

@@ -356,7 +356,7 @@ fn bad_values_name_their_key() {
         (
             "hydrostatic-column",
             "model = \"linear-elastic\"\ndensity = 1000.0\nyoung = 1e8\npoisson = 0.3",
-            "model = \"fluid\"\ndensity = 1000.0\nbulk = 1e8",
+            "model = \"drucker-prager\"\ndensity = 1000.0\nyoung = 1e8\npoisson = 0.3\ncohesion = 500.0\nfriction_angle = 20.0",
             "`reference.hydrostatic`",
         ),
         (
