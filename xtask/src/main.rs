@@ -45,7 +45,8 @@ Tasks:
              what .ci/run runs.
   bench      The comparison report (scenes x kernels x resolutions: tables, charts,
              raw results) in target/report/, after the criterion benches of every crate.
-               --quick                 coarse levels only, no criterion benches
+               --quick                 coarse levels only, no criterion benches (about 4
+                                       minutes on 2 cores)
                --no-criterion          reuse the criterion results already there
                --save-baseline NAME    save the criterion results as NAME
                --baseline NAME         compare the criterion results with NAME

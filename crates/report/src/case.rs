@@ -34,6 +34,8 @@ pub struct Case {
     pub variant: String,
     /// `--refine` factor.
     pub refine: f64,
+    /// The refinement is made by the study's level edits (in `set`), not `--refine`.
+    pub refine_by_edits: bool,
     /// `--particle-refine` factor.
     pub particle_refine: f64,
     /// `--end-time`.
@@ -92,7 +94,7 @@ impl Case {
             "--kernel".into(),
             self.kernel.clone(),
         ];
-        if self.refine != 1.0 {
+        if self.refine != 1.0 && !self.refine_by_edits {
             args.extend(["--refine".into(), self.refine.to_string()]);
         }
         if self.particle_refine != 1.0 {
@@ -120,6 +122,7 @@ fn base(common: &Common, kind: StudyKind, kernel: &str, transfer: &str, threads:
         transfer: transfer.to_string(),
         variant: String::new(),
         refine: 1.0,
+        refine_by_edits: false,
         particle_refine: 1.0,
         end_time: common.end_time,
         threads,
@@ -179,6 +182,10 @@ pub fn cases(matrix: &Matrix) -> Vec<Case> {
                         case.variant = variant.label.clone();
                         case.set.extend(variant.set.iter().cloned());
                         case.refine = refine;
+                        if let Some(edits) = study.level_edits(refine) {
+                            case.set.extend(edits.iter().cloned());
+                            case.refine_by_edits = true;
+                        }
                         out.push(case);
                     }
                 }

@@ -1,13 +1,16 @@
-//! The charts of each study, drawn from its records with `umls_io::chart`.
+//! The charts of each study, drawn from its records with `umls_io::chart`: every kernel
+//! in its fixed style ([`crate::styles`]), at most [`MAX_SERIES`] curves per panel,
+//! failed runs marked.
 
 use std::collections::BTreeMap;
 
 use umls_io::chart::{
-    Axis, Bar, LineChart, MapCell, MapPanel, Outcome, Series, StackedBars, StatusMap,
+    Axis, Bar, LineChart, MapCell, MapPanel, Outcome, PanelChart, Series, StackedBars, StatusMap,
 };
 
 use crate::matrix::{AccuracyStudy, HistoryStudy, StabilityStudy, ThroughputStudy, value_text};
 use crate::record::{Record, STAGES};
+use crate::styles::{distinct, kernel_style};
 
 /// Records grouped by chart series, in first-seen order.
 pub fn by_series<'a>(records: &[&'a Record]) -> Vec<(String, Vec<&'a Record>)> {
@@ -30,39 +33,185 @@ pub fn convergence_points(study: &AccuracyStudy, runs: &[&Record]) -> Vec<(f64, 
         .collect()
 }
 
-/// Error against stepping wall time, one series per kernel (and transfer, variant).
-pub fn speed_accuracy(study: &AccuracyStudy, records: &[&Record]) -> LineChart {
-    let series = by_series(records)
-        .into_iter()
-        .map(|(label, runs)| {
-            let points = runs
-                .iter()
-                .filter(|r| r.completed())
-                .filter_map(|r| Some((r.step_time_s?, r.metric?)))
-                .collect();
-            Series::new(label, points).with_markers()
-        })
-        .collect();
-    LineChart {
-        title: format!("{}: error against run time", study.common.title),
-        x: Axis::log("time in the steps [s] (output excluded)"),
-        y: Axis::log(study.metric_label.clone()),
-        series,
-    }
+/// Runs grouped by kernel, in first-seen order.
+type KernelRuns<'a> = Vec<(String, Vec<&'a Record>)>;
+
+/// A scaling curve: (series label, threads) → (kernel, (particles, ns per particle-step)).
+type ScalingCurves = BTreeMap<(String, usize), (String, Vec<(f64, f64)>)>;
+
+/// Most curves one panel shows; a study with more is split into panels.
+pub const MAX_SERIES: usize = 8;
+
+/// One panel's runs: a transfer and variant, and the kernels in it.
+#[derive(Debug, Clone)]
+pub struct Facet<'a> {
+    /// Panel title: the transfer and variant, and the kernel family when split.
+    pub title: String,
+    /// (kernel, its runs), at most [`MAX_SERIES`].
+    pub kernels: KernelRuns<'a>,
 }
 
-/// Error against cell size, one series per kernel (and transfer, variant).
-pub fn convergence(study: &AccuracyStudy, records: &[&Record]) -> LineChart {
-    let series = by_series(records)
-        .into_iter()
-        .map(|(label, runs)| Series::new(label, convergence_points(study, &runs)).with_markers())
-        .collect();
-    LineChart {
-        title: format!("{}: convergence", study.common.title),
-        x: Axis::log("cell size h [m]"),
-        y: Axis::log(study.metric_label.clone()),
-        series,
+/// The records split into panels: one per transfer and variant, in first-seen order,
+/// each with one series per kernel. A panel with more than [`MAX_SERIES`] kernels is
+/// split into the established kernels (UMLS among them) and UMLS's variants (`umls-*`),
+/// the variants led by `umls` itself, the reference to read them against, when it fits.
+pub fn facets<'a>(records: &[&'a Record]) -> Vec<Facet<'a>> {
+    let mut groups: Vec<((String, String), KernelRuns<'a>)> = Vec::new();
+    for r in records {
+        let key = (r.transfer.clone(), r.variant.clone());
+        let at = match groups.iter().position(|(k, _)| *k == key) {
+            Some(i) => i,
+            None => {
+                groups.push((key, Vec::new()));
+                groups.len() - 1
+            }
+        };
+        let kernels = &mut groups[at].1;
+        match kernels.iter_mut().find(|(k, _)| *k == r.kernel) {
+            Some((_, runs)) => runs.push(r),
+            None => kernels.push((r.kernel.clone(), vec![r])),
+        }
     }
+    let mut facets = Vec::new();
+    for ((transfer, variant), kernels) in groups {
+        let base: Vec<&str> = [transfer.as_str(), variant.as_str()]
+            .into_iter()
+            .filter(|p| !p.is_empty())
+            .collect();
+        let title = |family: &str| {
+            let mut parts = base.clone();
+            if !family.is_empty() {
+                parts.push(family);
+            }
+            parts.join(", ")
+        };
+        if kernels.len() <= MAX_SERIES {
+            facets.push(Facet {
+                title: title(""),
+                kernels,
+            });
+            continue;
+        }
+        let reference = kernels.iter().find(|(k, _)| k == "umls").cloned();
+        let (variants, established): (Vec<_>, Vec<_>) = kernels
+            .into_iter()
+            .partition(|(k, _)| k.starts_with("umls-"));
+        for chunk in established.chunks(MAX_SERIES) {
+            facets.push(Facet {
+                title: title("established kernels"),
+                kernels: chunk.to_vec(),
+            });
+        }
+        // The reference leads the variants' panel when there is room for it; otherwise
+        // it is in the panel just above.
+        let reference = reference.filter(|_| variants.len() < MAX_SERIES);
+        let room = MAX_SERIES - usize::from(reference.is_some());
+        for chunk in variants.chunks(room) {
+            facets.push(Facet {
+                title: title("UMLS variants"),
+                kernels: reference
+                    .iter()
+                    .cloned()
+                    .chain(chunk.iter().cloned())
+                    .collect(),
+            });
+        }
+    }
+    facets
+}
+
+/// A figure of one panel per facet; `series` makes a kernel's curve from its runs.
+fn panels(
+    title: String,
+    x: Axis,
+    y: Axis,
+    records: &[&Record],
+    series: impl Fn(&str, &[&Record]) -> Series,
+) -> PanelChart {
+    let panels = facets(records)
+        .into_iter()
+        .map(|facet| {
+            let styles: Vec<_> = facet.kernels.iter().map(|(k, _)| kernel_style(k)).collect();
+            let styles = distinct(&styles);
+            LineChart {
+                title: facet.title,
+                x: x.clone(),
+                y: y.clone(),
+                series: facet
+                    .kernels
+                    .iter()
+                    .zip(styles)
+                    .map(|((kernel, runs), style)| {
+                        let s = series(kernel, runs);
+                        match style {
+                            Some(style) => s.with_style(style),
+                            None => s,
+                        }
+                    })
+                    .collect(),
+            }
+        })
+        .collect();
+    PanelChart { title, panels }
+}
+
+/// A kernel's curve: the completed runs' points, and the failed runs marked at `x`.
+fn curve(
+    kernel: &str,
+    runs: &[&Record],
+    point: impl Fn(&Record) -> Option<(f64, f64)>,
+    x: impl Fn(&Record) -> Option<f64>,
+) -> Series {
+    let failed: Vec<&&Record> = runs.iter().filter(|r| !r.completed()).collect();
+    Series::new(
+        kernel,
+        runs.iter()
+            .filter(|r| r.completed())
+            .filter_map(|r| point(r))
+            .collect(),
+    )
+    .with_markers()
+    .with_failures(failed.iter().filter_map(|r| x(r)).collect(), failed.len())
+}
+
+/// The study's error against `x` of each run, one series per kernel, a panel per
+/// transfer and variant; failed runs are marked at their `x`.
+fn error_against(
+    study: &AccuracyStudy,
+    records: &[&Record],
+    what: &str,
+    axis: Axis,
+    x: impl Fn(&Record) -> Option<f64> + Copy,
+) -> PanelChart {
+    panels(
+        format!("{}: {what}", study.common.title),
+        axis,
+        Axis::log(study.metric_label.clone()),
+        records,
+        |kernel, runs| curve(kernel, runs, |r| Some((x(r)?, r.metric?)), x),
+    )
+}
+
+/// Error against stepping wall time.
+pub fn speed_accuracy(study: &AccuracyStudy, records: &[&Record]) -> PanelChart {
+    error_against(
+        study,
+        records,
+        "error against run time",
+        Axis::log("time in the steps [s] (output excluded)"),
+        |r| r.step_time_s,
+    )
+}
+
+/// Error against cell size.
+pub fn convergence(study: &AccuracyStudy, records: &[&Record]) -> PanelChart {
+    error_against(
+        study,
+        records,
+        "convergence",
+        Axis::log("cell size h [m]"),
+        |r| Some(study.h / r.refine),
+    )
 }
 
 /// One panel per kernel (and transfer): how each run of the sweep ended.
@@ -116,17 +265,28 @@ pub fn stability_map(study: &StabilityStudy, records: &[&Record]) -> StatusMap {
     }
 }
 
-/// A history column against time per series.
-pub fn history(study: &HistoryStudy, curves: &[(String, Vec<(f64, f64)>)]) -> LineChart {
-    LineChart {
-        title: study.common.title.clone(),
-        x: Axis::linear("time t [s]"),
-        y: Axis::linear(study.column_label.clone()),
-        series: curves
+/// A history column against time, one series per kernel, a panel per transfer and
+/// variant; a run that failed ends where it stopped and is counted in the legend.
+pub fn history(study: &HistoryStudy, curves: &[(&Record, Vec<(f64, f64)>)]) -> PanelChart {
+    let records: Vec<&Record> = curves.iter().map(|(r, _)| *r).collect();
+    let points_of = |r: &Record| {
+        curves
             .iter()
-            .map(|(label, points)| Series::new(label.clone(), points.clone()))
-            .collect(),
-    }
+            .find(|(c, _)| std::ptr::eq(*c, r))
+            .map(|(_, p)| p.clone())
+            .unwrap_or_default()
+    };
+    panels(
+        study.common.title.clone(),
+        Axis::linear("time t [s]"),
+        Axis::linear(study.column_label.clone()),
+        &records,
+        |kernel, runs| {
+            let points = runs.iter().flat_map(|r| points_of(r)).collect();
+            let failed = runs.iter().filter(|r| !r.completed()).count();
+            Series::new(kernel, points).with_failures(Vec::new(), failed)
+        },
+    )
 }
 
 /// Nanoseconds per particle-step of a run, split by stage.
@@ -165,31 +325,50 @@ pub fn stages(study: &ThroughputStudy, records: &[&Record]) -> StackedBars {
 }
 
 /// Time per particle-step against particle count per kernel and thread count (flat
-/// lines are linear scaling).
-pub fn scaling(study: &ThroughputStudy, records: &[&Record]) -> LineChart {
-    let mut groups: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+/// lines are linear scaling), at most [`MAX_SERIES`] curves per panel.
+pub fn scaling(study: &ThroughputStudy, records: &[&Record]) -> PanelChart {
+    let mut groups: ScalingCurves = BTreeMap::new();
     for r in records.iter().filter(|r| r.completed()) {
         if let (Some(n), Some(rate)) = (r.particles, r.particle_steps_per_second) {
             groups
-                .entry(format!("{}, {} threads", r.series(), r.threads))
-                .or_default()
+                .entry((r.series(), r.threads))
+                .or_insert_with(|| (r.kernel.clone(), Vec::new()))
+                .1
                 .push((n as f64, 1e9 / rate));
         }
     }
-    LineChart {
+    let curves: Vec<_> = groups.into_iter().collect();
+    let panels = curves
+        .chunks(MAX_SERIES)
+        .map(|chunk| {
+            let styles: Vec<_> = chunk.iter().map(|(_, (k, _))| kernel_style(k)).collect();
+            LineChart {
+                title: String::new(),
+                x: Axis::log("particles"),
+                y: Axis::log("wall time per particle-step [ns]"),
+                series: chunk
+                    .iter()
+                    .zip(distinct(&styles))
+                    .map(|(((label, threads), (_, points)), style)| {
+                        let mut points = points.clone();
+                        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+                        let s = Series::new(format!("{label}, {threads} threads"), points)
+                            .with_markers();
+                        match style {
+                            Some(style) => s.with_style(style),
+                            None => s,
+                        }
+                    })
+                    .collect(),
+            }
+        })
+        .collect();
+    PanelChart {
         title: format!(
             "{}: cost per particle-step against size",
             study.common.title
         ),
-        x: Axis::log("particles"),
-        y: Axis::log("wall time per particle-step [ns]"),
-        series: groups
-            .into_iter()
-            .map(|(label, mut points)| {
-                points.sort_by(|a, b| a.0.total_cmp(&b.0));
-                Series::new(label, points).with_markers()
-            })
-            .collect(),
+        panels,
     }
 }
 

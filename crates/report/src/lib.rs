@@ -9,9 +9,11 @@
 //! - [`runner`]: one run in a process of its own;
 //! - [`record`]: one row of results per run;
 //! - [`analysis`]: convergence orders and the Pareto front;
-//! - [`charts`]: the charts of each study;
+//! - [`charts`]: the charts of each study, in panels of at most eight curves;
+//! - [`styles`]: one colour, marker and dash per kernel, the same in every chart;
 //! - [`criterion`]: criterion's results, with throughput and the change against a
 //!   baseline;
+//! - [`summary`]: the generated summary that opens the report;
 //! - [`report`]: the whole report;
 //! - [`host`] and [`cpu`]: the machine and revision it was made on (the processor's
 //!   family, model and vector extensions besides its name; `xtask` shares `cpu.rs` for
@@ -56,5 +58,7 @@ pub mod matrix;
 pub mod record;
 pub mod report;
 pub mod runner;
+pub mod styles;
+pub mod summary;
 
 pub use error::{ReportError, Result};

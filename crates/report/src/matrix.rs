@@ -14,8 +14,9 @@
 use serde::Deserialize;
 
 use crate::error::{ReportError, Result};
+use crate::summary::SceneClass;
 
-/// The built-in matrices: `quick` (coarse levels, 761 runs, about 30 minutes on 2 cores)
+/// The built-in matrices: `quick` (coarse levels, about 4 minutes on 2 cores)
 /// and `full`.
 pub const BUILTIN: [(&str, &str); 2] = [
     ("quick", include_str!("../matrices/quick.toml")),
@@ -86,6 +87,21 @@ pub struct Variant {
     pub kernels: Vec<String>,
 }
 
+impl AccuracyStudy {
+    /// The edits of refinement level `refine` when the study gives its levels as edits.
+    pub fn level_edits(&self, refine: f64) -> Option<&[String]> {
+        self.levels
+            .iter()
+            .find(|l| l.refine == refine)
+            .map(|l| l.set.as_slice())
+    }
+
+    /// Whether the fitted orders use refinement level `refine`.
+    pub fn fits(&self, refine: f64) -> bool {
+        self.fit_levels.as_ref().is_none_or(|l| l.contains(&refine))
+    }
+}
+
 impl Variant {
     /// Whether `kernel` runs this variant.
     pub fn runs_with(&self, kernel: &str) -> bool {
@@ -105,13 +121,40 @@ pub struct AccuracyStudy {
     pub metric: String,
     /// Its axis label, with unit.
     pub metric_label: String,
-    /// Refinement factors (`umls run --refine`).
+    /// Refinement factors (`umls run --refine`), or the factors of `levels`.
     pub refine: Vec<f64>,
+    /// Refinement levels given as edits instead of `--refine`, for a scene on a mesh
+    /// file (which `--refine` cannot refine): each names its factor, one of `refine`,
+    /// and the edits that refine the scene by it (a finer mesh file, a finer seeding).
+    #[serde(default)]
+    pub levels: Vec<Level>,
     /// Cell size at refinement 1, for the convergence axis.
     pub h: f64,
     /// Variants (default: the scene as it is).
     #[serde(default)]
     pub variants: Vec<Variant>,
+    /// The regime the levels are in, stated in the report (e.g. "asymptotic: second-order
+    /// levels", or why an error floor is reached).
+    #[serde(default)]
+    pub regime: String,
+    /// The refinement factors inside the asymptotic regime, which the fitted orders use
+    /// (default: every level; empty: no order is fitted).
+    pub fit_levels: Option<Vec<f64>>,
+    /// The class of scene the summary lists it under (`grid-aligned`, `off-grid`,
+    /// `large-deformation`, `quasi-static`); none keeps it out of the summary.
+    #[serde(default)]
+    pub class: Option<SceneClass>,
+}
+
+/// A refinement level given as scene edits.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Level {
+    /// Its refinement factor (the cell size is `h / refine`).
+    pub refine: f64,
+    /// The edits that make it.
+    #[serde(default)]
+    pub set: Vec<String>,
 }
 
 /// One axis of a stability map.
@@ -265,6 +308,26 @@ impl Matrix {
             }
             if !(s.h.is_finite() && s.h > 0.0) {
                 return Err(bad(format!("{n}.h"), "must be positive"));
+            }
+            if !s.levels.is_empty() {
+                let factors: Vec<f64> = s.levels.iter().map(|l| l.refine).collect();
+                if factors != s.refine {
+                    return Err(bad(
+                        format!("{n}.levels"),
+                        "must give the factors of `refine`, in its order",
+                    ));
+                }
+            }
+            if let Some(f) = s
+                .fit_levels
+                .iter()
+                .flatten()
+                .find(|f| !s.refine.contains(f))
+            {
+                return Err(bad(
+                    format!("{n}.fit_levels"),
+                    &format!("{f} is not one of the study's refinement factors"),
+                ));
             }
             for v in &s.variants {
                 if let Some(k) = v.kernels.iter().find(|k| !s.common.kernels.contains(k)) {

@@ -145,6 +145,9 @@ pub fn generate(
         out: out.clone(),
     };
     doc.header(matrix, options, &host, elapsed, &records);
+    for line in crate::summary::lines(matrix, &records) {
+        doc.line(line);
+    }
     doc.accuracy(matrix, &records)?;
     doc.stability(matrix, &records)?;
     doc.histories(matrix, &records, &histories)?;
@@ -292,6 +295,9 @@ impl Document {
                 "Scene `{}`, metric `{}` ({}), refinement {:?} of h = {}.\n",
                 study.common.scene, study.metric, study.metric_label, study.refine, study.h
             ));
+            if !study.regime.is_empty() {
+                self.line(format!("Regime: {}\n", study.regime));
+            }
             let name = &study.common.name;
             self.chart(&format!("{name}-speed-accuracy"), |p| {
                 charts::speed_accuracy(study, &runs).write_svg(p)
@@ -328,15 +334,35 @@ impl Document {
             }
             self.line("");
             if study.refine.len() > 1 {
-                self.line("| kernel | observed order (least squares) | orders between levels |");
+                let fitted: Vec<String> = study
+                    .refine
+                    .iter()
+                    .filter(|&&f| study.fits(f))
+                    .map(|f| f.to_string())
+                    .collect();
+                self.line(format!(
+                    "Observed orders fitted over the refinements inside the regime: {}.\n",
+                    if fitted.is_empty() {
+                        "none (no order is fitted)".to_string()
+                    } else {
+                        fitted.join(", ")
+                    }
+                ));
+                self.line("| kernel | observed order (least squares, fitted levels) | orders between levels |");
                 self.line("|---|---|---|");
                 for (label, group) in charts::by_series(&runs) {
                     let pts = charts::convergence_points(study, &group);
+                    let inside: Vec<&Record> = group
+                        .iter()
+                        .copied()
+                        .filter(|r| study.fits(r.refine))
+                        .collect();
+                    let fit_pts = charts::convergence_points(study, &inside);
                     let pairwise: Vec<String> =
                         pts.windows(2).map(|w| num(fitted_order(w))).collect();
                     self.line(format!(
                         "| {label} | {} | {} |",
-                        num(fitted_order(&pts)),
+                        num(fitted_order(&fit_pts)),
                         if pairwise.is_empty() {
                             "—".into()
                         } else {
@@ -460,7 +486,7 @@ impl Document {
                     points.last().map(|p| p.1),
                     csv_name,
                 ));
-                series.push((r.series(), points));
+                series.push((r, points));
             }
             self.line(format!("### {}\n", study.common.title));
             self.line(format!(
