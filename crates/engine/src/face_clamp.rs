@@ -27,8 +27,7 @@
 //! cantilever four cells thick: its aligned peak 2.4 % shallower at W = 10⁶ than at
 //! 10⁴ and 7.5 % at 10⁸, where the turned runs part by up to 15 %; the default 10⁴ is
 //! the smallest W measured that keeps them within 5 % there, and three times finer every
-//! W from 10² to 10⁸ keeps them within 3 %: docs/umls-kernel.md, *The clamp held on its
-//! face*).
+//! W from 10² to 10⁸ keeps them within 3 %: docs/umls-kernel.md, *Clamps*).
 
 use nalgebra::{Cholesky, DMatrix, DVector, Dyn, SVector};
 use umls_transfer::{Kernel, Stencil};
