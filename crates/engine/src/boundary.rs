@@ -18,8 +18,10 @@ use nalgebra::SVector;
 use rayon::prelude::*;
 use umls_transfer::{DomainExit, Kernel};
 
+use crate::collider::Collider;
 use crate::face_clamp::FaceClamp;
 use crate::fitted_clamp::FittedClamp;
+use crate::moving_collider::MovingCollider;
 
 /// Per-node marks of [`Boundary::node_marks`].
 const SLIP: u8 = 1;
@@ -44,6 +46,9 @@ pub struct Wall<const D: usize> {
     pub point: SVector<f64, D>,
     /// Unit normal pointing away from the material.
     pub normal: SVector<f64, D>,
+    /// Coulomb's friction coefficient μ of a slip wall (0: frictionless); a fixed wall
+    /// ignores it.
+    pub friction: f64,
 }
 
 impl<const D: usize> Wall<D> {
@@ -72,7 +77,16 @@ impl<const D: usize> Wall<D> {
             kind,
             point,
             normal: unit,
+            friction: 0.0,
         })
+    }
+
+    /// This wall with Coulomb's friction coefficient `mu` (a slip wall's).
+    pub fn with_friction(self, mu: f64) -> Self {
+        Self {
+            friction: mu,
+            ..self
+        }
     }
 
     /// Signed distance of `x` from the plane, positive beyond the wall.
@@ -94,8 +108,21 @@ pub struct Boundary<const D: usize> {
     pub slip: Vec<(u32, SVector<f64, D>)>,
     /// Whether slip nodes may move away from the wall (v·n > 0 kept).
     pub separate: bool,
+    /// Nodes under Coulomb friction: the node, the unit normal into the wall and the
+    /// friction coefficient μ. A node moving into the wall loses that motion and as much
+    /// tangential speed as μ times it ([`coulomb`]); a node moving away is free.
+    pub frictional: Vec<(u32, SVector<f64, D>, f64)>,
     /// Planar walls the particles may not cross (their nodes are in `fixed`/`slip`).
     pub walls: Vec<Wall<D>>,
+    /// Walls of any shape the particles may not cross, as signed distances (their nodes
+    /// are in `fixed`, `slip` or `frictional`; see [`Self::add_collider`]).
+    pub colliders: Vec<Collider<D>>,
+    /// Rigid obstacles in prescribed motion ([`Self::add_moving_collider`]): which nodes
+    /// they hold is decided every step, at their position at [`Self::time`].
+    pub moving: Vec<MovingCollider<D>>,
+    /// The time the constrained velocities belong to: where moving obstacles are. The step
+    /// sets it to its end time before the grid update.
+    pub time: f64,
     /// Node sets whose reaction forces are summed each step (one per wall or group a
     /// user wants to read; a node in two sets counts in both). See
     /// [`crate::Simulation::reactions`].
@@ -162,9 +189,54 @@ impl<const D: usize> Boundary<D> {
         let nodes = Self::nodes_of_wall(kernel, &wall, tolerance);
         match wall.kind {
             WallKind::Fixed => self.fixed.extend(nodes.iter().copied()),
+            WallKind::Slip if wall.friction > 0.0 => self
+                .frictional
+                .extend(nodes.iter().map(|&n| (n, wall.normal, wall.friction))),
             WallKind::Slip => self.slip.extend(nodes.iter().map(|&n| (n, wall.normal))),
         }
         self.walls.push(wall);
+        nodes
+    }
+
+    /// Adds `collider`: the nodes of `kernel` on or beyond its surface (within
+    /// `tolerance`) and at most `reach` beyond it take its condition along its normal
+    /// there, and the particles are kept on the material side. Returns the nodes held.
+    pub fn add_collider<K: Kernel<D>>(
+        &mut self,
+        kernel: &K,
+        collider: Collider<D>,
+        tolerance: f64,
+        reach: f64,
+    ) -> Vec<u32> {
+        let positions = (0..kernel.node_count()).map(|n| kernel.node_position(n));
+        let held = collider.node_conditions(positions, tolerance, reach);
+        for &(node, normal, friction) in &held {
+            match friction {
+                None => self.fixed.push(node),
+                Some(mu) if mu > 0.0 => self.frictional.push((node, normal, mu)),
+                Some(_) => self.slip.push((node, normal)),
+            }
+        }
+        self.colliders.push(collider);
+        held.into_iter().map(|(node, _, _)| node).collect()
+    }
+
+    /// Adds an obstacle moving at `velocity` from t = 0 to `until`: the nodes of
+    /// `kernel` it may reach take its condition whenever they are on or beyond its surface
+    /// (within `tolerance`) and at most `reach` beyond it, relative to its velocity, and
+    /// particles are kept out of it. Returns the nodes it may reach (its reaction set).
+    pub fn add_moving_collider<K: Kernel<D>>(
+        &mut self,
+        kernel: &K,
+        collider: Collider<D>,
+        velocity: SVector<f64, D>,
+        tolerance: f64,
+        reach: f64,
+        until: f64,
+    ) -> Vec<u32> {
+        let moving = MovingCollider::new(kernel, collider, velocity, tolerance, reach, until);
+        let nodes = moving.candidate_nodes();
+        self.moving.push(moving);
         nodes
     }
 
@@ -188,6 +260,13 @@ impl<const D: usize> Boundary<D> {
                 *v -= normal * vn;
             }
         }
+        for (node, normal, mu) in &self.frictional {
+            let v = &mut velocity[*node as usize];
+            *v = coulomb(v, normal, *mu);
+        }
+        for obstacle in &self.moving {
+            obstacle.apply_range(velocity, 0, self.time, |_| true, None);
+        }
     }
 
     /// Orders the node conditions by node, which [`Self::apply_live`] needs. The sort of
@@ -203,6 +282,9 @@ impl<const D: usize> Boundary<D> {
         if !self.slip.par_windows(2).all(|w| w[0].0 <= w[1].0) {
             self.slip.sort_by_key(|(node, _)| *node);
         }
+        if !self.frictional.is_sorted_by_key(|(node, _, _)| *node) {
+            self.frictional.sort_by_key(|(node, _, _)| *node);
+        }
     }
 
     /// [`Self::apply`] in parallel over the chunks of [`NODE_CHUNK`] nodes with a
@@ -210,15 +292,22 @@ impl<const D: usize> Boundary<D> {
     /// the others hold zero velocities, which every condition keeps. Needs
     /// [`Self::sort_by_node`]. Each node sees its conditions in the same order as
     /// under [`Self::apply`] (fixed first, then its slip normals), so the result is the
-    /// same, bit for bit.
-    pub(crate) fn apply_live(&self, velocity: &mut [SVector<f64, D>], live: &[bool]) {
-        velocity
+    /// same, bit for bit. With the nodes' masses, returns the work moving obstacles did
+    /// on the nodes (impulse times velocity, [`MovingCollider`]), summed in chunk order;
+    /// else 0.
+    pub(crate) fn apply_live(
+        &self,
+        velocity: &mut [SVector<f64, D>],
+        live: &[bool],
+        mass: Option<&[f64]>,
+    ) -> f64 {
+        let works: Vec<f64> = velocity
             .par_chunks_mut(NODE_CHUNK)
             .zip(live.par_chunks(SEGMENTS_PER_CHUNK))
             .enumerate()
-            .for_each(|(c, (chunk, live))| {
+            .map(|(c, (chunk, live))| {
                 if !live.iter().any(|&l| l) {
-                    return;
+                    return 0.0;
                 }
                 let start = (c * NODE_CHUNK) as u32;
                 let end = start + chunk.len() as u32;
@@ -239,13 +328,31 @@ impl<const D: usize> Boundary<D> {
                         *v -= normal * vn;
                     }
                 }
-            });
+                let frictional =
+                    &self.frictional[self.frictional.partition_point(|(n, _, _)| *n < start)
+                        ..self.frictional.partition_point(|(n, _, _)| *n < end)];
+                for (node, normal, mu) in frictional.iter().filter(|(n, _, _)| live_node(*n)) {
+                    let v = &mut chunk[(node - start) as usize];
+                    *v = coulomb(v, normal, *mu);
+                }
+                let masses = mass.map(|m| &m[start as usize..end as usize]);
+                self.moving
+                    .iter()
+                    .map(|obstacle| {
+                        obstacle.apply_range(chunk, start, self.time, live_node, masses)
+                    })
+                    .sum::<f64>()
+            })
+            .collect();
+        // In chunk order: the same sum on any number of threads.
+        works.iter().sum()
     }
 
     /// Whether any node condition is set (walls given as node sets, such as mesh groups).
     pub(crate) fn has_node_conditions(&self) -> bool {
         !self.fixed.is_empty()
             || !self.slip.is_empty()
+            || !self.frictional.is_empty()
             || !self.fitted.is_empty()
             || !self.faces.is_empty()
     }
@@ -253,7 +360,12 @@ impl<const D: usize> Boundary<D> {
     /// Marks per node: fixed, slip, or free.
     pub(crate) fn node_marks(&self, nodes: usize) -> Vec<u8> {
         let mut marks = vec![0u8; nodes];
-        for (node, _) in &self.slip {
+        for node in self
+            .slip
+            .iter()
+            .map(|(n, _)| n)
+            .chain(self.frictional.iter().map(|(n, _, _)| n))
+        {
             marks[*node as usize] |= SLIP;
         }
         for &node in self
@@ -306,16 +418,43 @@ impl<const D: usize> Boundary<D> {
                 moved = true;
                 match wall.kind {
                     WallKind::Fixed => *v = SVector::zeros(),
-                    WallKind::Slip => {
-                        let vn = v.dot(&wall.normal);
-                        if vn > 0.0 {
-                            *v -= wall.normal * vn;
-                        }
-                    }
+                    WallKind::Slip => *v = coulomb(v, &wall.normal, wall.friction),
                 }
             }
         }
+        for collider in &self.colliders {
+            moved |= collider.hold(x, v);
+        }
+        for obstacle in &self.moving {
+            moved |= obstacle.hold(x, v, self.time);
+        }
         moved
+    }
+}
+
+/// Coulomb friction on a velocity `v` against a wall with unit normal `normal` (pointing
+/// into the wall) and coefficient `mu`: a velocity moving into the wall (v·n > 0) loses
+/// that normal part, and its tangential part shrinks by μ times it, to rest at most
+/// (stick); a velocity moving away is left as it is. μ = 0 is frictionless slip that
+/// lets the body separate.
+pub(crate) fn coulomb<const D: usize>(
+    v: &SVector<f64, D>,
+    normal: &SVector<f64, D>,
+    mu: f64,
+) -> SVector<f64, D> {
+    let vn = v.dot(normal);
+    if vn <= 0.0 {
+        return *v;
+    }
+    let tangential = v - normal * vn;
+    if mu == 0.0 {
+        return tangential;
+    }
+    let speed = tangential.norm();
+    if speed <= mu * vn {
+        SVector::zeros()
+    } else {
+        tangential * (1.0 - mu * vn / speed)
     }
 }
 
@@ -324,6 +463,20 @@ mod tests {
     use nalgebra::Vector3;
 
     use super::*;
+
+    /// Coulomb's law on a node moving into a wall at 45°: μ = 0.5 takes half the
+    /// tangential speed, μ = 1 stops it, and a node moving away is left alone.
+    #[test]
+    fn coulomb_friction_takes_mu_times_the_normal_speed() {
+        let n = Vector3::new(0.0, 0.0, 1.0);
+        let v = Vector3::new(2.0, 0.0, 2.0);
+        assert_eq!(coulomb(&v, &n, 0.0), Vector3::new(2.0, 0.0, 0.0));
+        assert_eq!(coulomb(&v, &n, 0.5), Vector3::new(1.0, 0.0, 0.0));
+        assert_eq!(coulomb(&v, &n, 1.0), Vector3::zeros());
+        assert_eq!(coulomb(&v, &n, 3.0), Vector3::zeros());
+        let away = Vector3::new(2.0, 0.0, -1.0);
+        assert_eq!(coulomb(&away, &n, 0.5), away);
+    }
 
     /// Sorted and applied per live chunk in parallel, the node conditions give what the
     /// serial pass over the lists as given gives, bit for bit: nodes under several
@@ -373,9 +526,11 @@ mod tests {
             };
             for _ in 0..3000 {
                 let node = (next() % nodes as u64) as u32;
-                match next() % 4 {
+                let normal = normals[(next() % 3) as usize];
+                match next() % 5 {
                     0 => boundary.fixed.push(node),
-                    _ => boundary.slip.push((node, normals[(next() % 3) as usize])),
+                    1 => boundary.frictional.push((node, normal, 0.4)),
+                    _ => boundary.slip.push((node, normal)),
                 }
             }
             // Corners: the same nodes under two and three walls, in both orders.
@@ -388,8 +543,9 @@ mod tests {
             boundary.apply(&mut serial);
             boundary.sort_by_node();
             assert!(boundary.fixed.is_sorted());
+            assert!(boundary.frictional.is_sorted_by_key(|(n, _, _)| *n));
             let mut parallel = velocity.clone();
-            boundary.apply_live(&mut parallel, &live);
+            boundary.apply_live(&mut parallel, &live, None);
             for (i, (a, b)) in serial.iter().zip(&parallel).enumerate() {
                 assert_eq!(
                     a.map(f64::to_bits),

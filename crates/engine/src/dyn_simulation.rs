@@ -8,6 +8,7 @@ use umls_constitutive::Constitutive;
 use umls_transfer::Kernel;
 
 use crate::boundary::{Boundary, Reaction, Wall};
+use crate::collider::Collider;
 use crate::diagnostics::Diagnostics;
 use crate::error::EngineError;
 use crate::face_clamp::FaceClamp;
@@ -75,6 +76,18 @@ pub trait DynSimulation<const D: usize> {
     fn boundary_mut(&mut self) -> &mut Boundary<D>;
     /// Adds a wall; the nodes it constrains ([`Boundary::add_wall`]).
     fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> Vec<u32>;
+    /// Adds a wall of any shape; the nodes it holds ([`Boundary::add_collider`]).
+    fn add_collider(&mut self, collider: Collider<D>, tolerance: f64, reach: f64) -> Vec<u32>;
+    /// Adds an obstacle in prescribed motion; the nodes it may reach
+    /// ([`Boundary::add_moving_collider`]).
+    fn add_moving_collider(
+        &mut self,
+        collider: Collider<D>,
+        velocity: SVector<f64, D>,
+        tolerance: f64,
+        reach: f64,
+        until: f64,
+    ) -> Vec<u32>;
     /// Adds a clamp held on its face: the region's `nodes` and the face `points`, the
     /// face points' residuals weighted by `penalty` (else the default); the nodes its
     /// constraint moves.
@@ -169,6 +182,21 @@ where
     }
     fn add_wall(&mut self, wall: Wall<D>, tolerance: f64) -> Vec<u32> {
         self.boundary.add_wall(&self.kernel, wall, tolerance)
+    }
+    fn add_collider(&mut self, collider: Collider<D>, tolerance: f64, reach: f64) -> Vec<u32> {
+        self.boundary
+            .add_collider(&self.kernel, collider, tolerance, reach)
+    }
+    fn add_moving_collider(
+        &mut self,
+        collider: Collider<D>,
+        velocity: SVector<f64, D>,
+        tolerance: f64,
+        reach: f64,
+        until: f64,
+    ) -> Vec<u32> {
+        self.boundary
+            .add_moving_collider(&self.kernel, collider, velocity, tolerance, reach, until)
     }
     fn add_face_clamp(
         &mut self,

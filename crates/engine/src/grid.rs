@@ -91,6 +91,8 @@ pub(crate) struct GridUpdateReport<const D: usize> {
     pub redistributed_momentum: SVector<f64, D>,
     /// Nodes whose increment for velocity gradients was mass-scaled.
     pub scaled_nodes: usize,
+    /// Work moving obstacles did on the nodes: their impulse times their velocity.
+    pub boundary_work: f64,
 }
 
 /// The momenta the reaction sets' nodes would reach without constraints,
@@ -232,6 +234,7 @@ impl<const D: usize> Grid<D> {
             dropped_mass: 0.0,
             redistributed_momentum: SVector::zeros(),
             scaled_nodes: 0,
+            boundary_work: 0.0,
         };
         let mut active_mass = 0.0;
         if let Some(r) = reactions.as_deref_mut() {
@@ -351,9 +354,11 @@ impl<const D: usize> Grid<D> {
                 });
         }
         if keep_velocity {
-            boundary.apply_live(&mut self.velocity, &self.live);
+            boundary.apply_live(&mut self.velocity, &self.live, None);
         }
-        boundary.apply_live(&mut self.new_velocity, &self.live);
+        // The work moving obstacles do is energy put in, as gravity's is.
+        report.boundary_work =
+            boundary.apply_live(&mut self.new_velocity, &self.live, Some(&self.mass));
         if let Some(r) = reactions {
             r.0.reactions(boundary, &self.mass, &self.new_velocity, dt, &mut r.1);
         }

@@ -53,6 +53,7 @@
 //! ```
 
 mod boundary;
+mod collider;
 mod diagnostics;
 mod dyn_simulation;
 mod error;
@@ -61,9 +62,11 @@ mod fitted_clamp;
 pub mod geostatic;
 mod grid;
 mod memory;
+mod moving_collider;
 mod parallel;
 mod particles;
 pub mod quadratic_modes;
+mod sampled_distance;
 mod scatter;
 mod seeding;
 mod settings;
@@ -74,14 +77,17 @@ mod timing;
 mod transfer;
 
 pub use boundary::{Boundary, Reaction, Wall, WallKind};
+pub use collider::{Collider, NodeCondition};
 pub use diagnostics::Diagnostics;
 pub use dyn_simulation::DynSimulation;
 pub use error::EngineError;
 pub use face_clamp::{FACE_CLAMP_PENALTY, FACE_CLAMP_REGULARISATION, FaceClamp, face_points};
 pub use fitted_clamp::{FITTED_CLAMP_REGULARISATION, FittedClamp};
 pub use memory::MemoryUse;
+pub use moving_collider::MovingCollider;
 pub use particles::Particles;
 pub use quadratic_modes::{MAX_QUADRATIC_MODES, QUADRATIC_RIDGE, QuadraticModes};
+pub use sampled_distance::{MAX_SAMPLES, SampledDistance, SampledDistanceError};
 pub use seeding::{Inside, Region, lattice_points, lattice_samples};
 pub use settings::{Damping, MassMatrix, StencilStorage, StepSettings, TimeStepControl};
 pub use simulation::{BodyForce, Simulation};

@@ -641,6 +641,9 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
                 ),
             };
         self.dt = dt;
+        // Every condition of this step acts on velocities of its end, where moving
+        // obstacles then stand.
+        self.boundary.time = self.time + dt;
         // The stability limit with the speeds and densities the step starts from (those
         // an adaptive step is sized by, so a cfl ≤ 1 never trips it).
         let stable = self.stable_step_from(1.0, self.totals.max_speed, self.totals.min_density);
@@ -719,6 +722,7 @@ impl<const D: usize, K: Kernel<D>, M: Constitutive<D>, T: TransferScheme> Simula
         self.totals.dropped_mass += report.dropped_mass;
         self.totals.redistributed_momentum += report.redistributed_momentum;
         self.totals.mass_scaled_nodes += report.scaled_nodes;
+        self.totals.external_work += report.boundary_work;
         if let Some(node) = self.grid.first_non_finite_velocity() {
             return Err(EngineError::NonFinite {
                 step,

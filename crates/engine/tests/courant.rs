@@ -30,6 +30,7 @@ fn run_into_wall(courant: f64) -> Result<(), EngineError> {
         kind: WallKind::Fixed,
         point: SVector::from([0.5 + 0.1 * H]),
         normal: SVector::from([1.0]),
+        friction: 0.0,
     });
     sim.step()?;
     // The wall holds the particle with its velocity zero.

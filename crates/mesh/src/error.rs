@@ -104,6 +104,9 @@ pub enum MeshError {
         /// The feature to enable.
         feature: &'static str,
     },
+    /// A distance to boundary facets was asked for, and no boundary facet was chosen.
+    #[error("no boundary facet was chosen to measure a distance to")]
+    NoFacets,
     /// A mesh generator got a parameter out of its range.
     #[error("generator parameter `{parameter}` = {value}: {reason}")]
     InvalidParameter {

@@ -44,6 +44,7 @@
 mod barycentric;
 mod csr;
 mod error;
+mod facet_distance;
 pub mod generate;
 mod geometry;
 mod locate;
@@ -57,6 +58,7 @@ mod topology;
 pub use barycentric::{Barycentric, BarycentricGradients, MAX_SIMPLEX_VERTICES};
 pub use csr::Csr;
 pub use error::MeshError;
+pub use facet_distance::FacetDistance;
 pub use locate::{INSIDE_TOLERANCE, Located, Walk};
 pub use mesh::{DEGENERACY_TOLERANCE, EntityCounts, Orientation, Point, SimplexMesh};
 pub use quality::{QualitySummary, SimplexQuality};

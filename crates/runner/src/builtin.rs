@@ -13,7 +13,7 @@ pub struct Builtin {
 }
 
 /// Every built-in scene.
-pub const BUILTIN: [Builtin; 17] = [
+pub const BUILTIN: [Builtin; 18] = [
     Builtin {
         name: "colliding-disks",
         summary: "two elastic disks collide and rebound (Sulsky et al. 1994) on a jittered triangle mesh",
@@ -33,6 +33,11 @@ pub const BUILTIN: [Builtin; 17] = [
         name: "hydrostatic-column",
         summary: "elastic column at rest under gravity between slip walls (plane strain), against the closed-form stress and settlement",
         toml: include_str!("../../../scenes/hydrostatic-column.toml"),
+    },
+    Builtin {
+        name: "sliding-block",
+        summary: "an elastic block slides down a 30° incline with Coulomb friction, against the closed-form velocity",
+        toml: include_str!("../../../scenes/sliding-block.toml"),
     },
     Builtin {
         name: "hydrostatic-column-tilted",

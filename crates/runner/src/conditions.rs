@@ -1,13 +1,17 @@
 //! The scene's boundary conditions on the kernel's nodes: planes become walls, mesh
-//! groups become node sets (a staircase of outside nodes for a grid), regions select the
-//! nodes inside them; each condition's nodes also become a reaction set, so its force is
-//! reported.
+//! groups become node sets (for a kernel whose nodes do not conform to the mesh, a
+//! signed-distance collider), regions select the nodes inside them; a slip condition may
+//! carry Coulomb friction. Each condition's nodes also become a reaction set, so its
+//! force is reported.
 
 use nalgebra::SVector;
-use umls_engine::{FittedClamp, Region, Wall, WallKind, face_points};
+use std::sync::Arc;
+
+use umls_engine::{Collider, FittedClamp, Region, SampledDistance, Wall, WallKind, face_points};
 
 use crate::context::Context;
 use crate::error::Result;
+use crate::group_wall::{GroupWall, NODE_REACH};
 use crate::handle::Run;
 use crate::schema::{BoundaryKind, Imposed};
 use crate::setup::BoundaryTarget;
@@ -18,16 +22,30 @@ pub(crate) fn apply_boundaries<const D: usize>(
     sim: &mut dyn Run<D>,
 ) -> Result<()> {
     for (i, (kind, target)) in ctx.setup.boundaries.iter().enumerate() {
+        // Validated with the set-up: finite, not negative, on slip conditions only.
+        let friction = ctx.scene.spec.boundaries[i].friction.unwrap_or(0.0);
         let nodes = match target {
-            BoundaryTarget::Plane { point, normal } => plane(ctx, sim, i, *kind, point, normal)?,
+            BoundaryTarget::Plane { point, normal } => {
+                plane(ctx, sim, i, *kind, friction, point, normal)?
+            }
             BoundaryTarget::Vertices(vertices) if !ctx.mesh_kernel => {
-                let nodes = staircase(ctx, sim, i, vertices)?;
-                hold(sim, *kind, &nodes);
-                nodes.iter().map(|(n, _)| *n).collect()
+                collider(ctx, sim, i, *kind, friction, vertices)?
             }
             BoundaryTarget::Vertices(vertices) => {
-                hold(sim, *kind, vertices);
+                hold(sim, *kind, friction, vertices);
                 vertices.iter().map(|(v, _)| *v).collect()
+            }
+            BoundaryTarget::Shape {
+                region,
+                inside,
+                velocity,
+            } => {
+                let wall = ShapeWall {
+                    region,
+                    inside: *inside,
+                    velocity: ctx.setup.frame.vector_to_world(velocity),
+                };
+                wall.apply(ctx, sim, i, *kind, friction)?
             }
             BoundaryTarget::Region {
                 region,
@@ -38,6 +56,7 @@ pub(crate) fn apply_boundaries<const D: usize>(
                 let held = HeldRegion {
                     region,
                     normal: normal.as_ref(),
+                    friction,
                     imposed: *imposed,
                     penalty: *penalty,
                 };
@@ -50,25 +69,31 @@ pub(crate) fn apply_boundaries<const D: usize>(
     Ok(())
 }
 
+/// The engine's wall kind of a condition.
+fn wall_kind(kind: BoundaryKind) -> WallKind {
+    match kind {
+        BoundaryKind::Fixed => WallKind::Fixed,
+        BoundaryKind::Slip => WallKind::Slip,
+    }
+}
+
 /// A wall on the plane through `point`; returns the nodes it holds.
 fn plane<const D: usize>(
     ctx: &Context<'_, D>,
     sim: &mut dyn Run<D>,
     i: usize,
     kind: BoundaryKind,
+    friction: f64,
     point: &SVector<f64, D>,
     normal: &SVector<f64, D>,
 ) -> Result<Vec<u32>> {
-    let wall_kind = match kind {
-        BoundaryKind::Fixed => WallKind::Fixed,
-        BoundaryKind::Slip => WallKind::Slip,
-    };
     let tolerance = 1e-6 * sim.spacing();
-    let wall = Wall::facing(wall_kind, *point, *normal, sim.positions()).ok_or_else(|| {
-        ctx.scene
-            .value_error(format!("boundaries[{i}].plane.normal"), "must not be zero")
-    })?;
-    let nodes = sim.add_wall(wall, tolerance);
+    let wall =
+        Wall::facing(wall_kind(kind), *point, *normal, sim.positions()).ok_or_else(|| {
+            ctx.scene
+                .value_error(format!("boundaries[{i}].plane.normal"), "must not be zero")
+        })?;
+    let nodes = sim.add_wall(wall.with_friction(friction), tolerance);
     if nodes.is_empty() {
         return Err(ctx.scene.value_error(
             format!("boundaries[{i}].plane"),
@@ -78,55 +103,58 @@ fn plane<const D: usize>(
     Ok(nodes)
 }
 
-/// Fixes or lets slip the given nodes, each with its wall normal.
+/// Fixes the given nodes, or lets them slip along their wall normals (with Coulomb
+/// friction `friction`).
 fn hold<const D: usize>(
     sim: &mut dyn Run<D>,
     kind: BoundaryKind,
+    friction: f64,
     nodes: &[(u32, SVector<f64, D>)],
 ) {
+    let boundary = sim.boundary_mut();
     match kind {
-        BoundaryKind::Fixed => sim
-            .boundary_mut()
-            .fixed
-            .extend(nodes.iter().map(|(n, _)| *n)),
-        BoundaryKind::Slip => sim.boundary_mut().slip.extend(nodes.iter().copied()),
+        BoundaryKind::Fixed => boundary.fixed.extend(nodes.iter().map(|(n, _)| *n)),
+        BoundaryKind::Slip if friction > 0.0 => boundary
+            .frictional
+            .extend(nodes.iter().map(|&(n, normal)| (n, normal, friction))),
+        BoundaryKind::Slip => boundary.slip.extend(nodes.iter().copied()),
     }
 }
 
-/// A mesh group as a grid sees it, a staircase: the grid's nodes outside the mesh within
-/// three spacings of a group vertex, each with its nearest group vertex's normal.
-fn staircase<const D: usize>(
+/// A mesh group as a kernel whose nodes do not conform to it sees it: a signed-distance
+/// collider ([`GroupWall`]) that holds the grid nodes on or beyond the wall, along its
+/// normal there, and keeps the particles inside. Returns the nodes it holds.
+fn collider<const D: usize>(
     ctx: &Context<'_, D>,
-    sim: &dyn Run<D>,
+    sim: &mut dyn Run<D>,
     i: usize,
+    kind: BoundaryKind,
+    friction: f64,
     vertices: &[(u32, SVector<f64, D>)],
-) -> Result<Vec<(u32, SVector<f64, D>)>> {
+) -> Result<Vec<u32>> {
+    let key = format!("boundaries[{i}].group");
     let Some(mesh) = ctx.setup.background.mesh() else {
-        return Err(ctx.scene.value_error(
-            format!("boundaries[{i}].group"),
-            "a group condition needs the mesh it belongs to",
-        ));
+        return Err(ctx
+            .scene
+            .value_error(key, "a group condition needs the mesh it belongs to"));
     };
-    let reach = 3.0 * sim.spacing();
-    let nodes: Vec<(u32, SVector<f64, D>)> = sim
-        .node_positions()
-        .iter()
-        .enumerate()
-        .filter(|(_, x)| mesh.locate(x).is_none())
-        .filter_map(|(n, x)| {
-            vertices
-                .iter()
-                .map(|(v, normal)| ((mesh.vertex(*v as usize) - x).norm(), normal))
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .filter(|(d, _)| *d <= reach)
-                .map(|(_, normal)| (n as u32, *normal))
-        })
-        .collect();
+    let ids: Vec<u32> = vertices.iter().map(|(v, _)| *v).collect();
+    let wall = GroupWall::new(mesh, &ids).map_err(|e| {
+        ctx.scene.value_error(
+            key.clone(),
+            format!("no boundary facet has all its vertices in the group ({e})"),
+        )
+    })?;
+    let spacing = sim.spacing();
+    let collider = wall
+        .collider(wall_kind(kind), friction, spacing)
+        .map_err(|e| ctx.scene.value_error(key.clone(), e.to_string()))?;
+    let nodes = sim.add_collider(collider, 1e-6 * spacing, NODE_REACH * spacing);
     if nodes.is_empty() {
         return Err(ctx.scene.value_error(
-            format!("boundaries[{i}].group"),
+            key,
             format!(
-                "no {} node lies outside the mesh near the group",
+                "no {} node lies on or beyond the group's wall",
                 ctx.kernel_name
             ),
         ));
@@ -134,10 +162,81 @@ fn staircase<const D: usize>(
     Ok(nodes)
 }
 
+/// The surface of a region as a wall for any kernel, at rest or in rigid translation.
+struct ShapeWall<'a, const D: usize> {
+    region: &'a Region<D>,
+    inside: bool,
+    /// World frame.
+    velocity: SVector<f64, D>,
+}
+
+impl<const D: usize> ShapeWall<'_, D> {
+    /// The region's signed distance (scene frame, which a rotation into the world keeps),
+    /// sampled at half the kernel's spacing over the nodes' box (and the box the motion
+    /// sweeps back over, for a moving wall), as a collider. Returns the nodes it holds, or
+    /// may reach when it moves.
+    fn apply(
+        &self,
+        ctx: &Context<'_, D>,
+        sim: &mut dyn Run<D>,
+        i: usize,
+        kind: BoundaryKind,
+        friction: f64,
+    ) -> Result<Vec<u32>> {
+        let name = if self.inside { "container" } else { "obstacle" };
+        let key = format!("boundaries[{i}].{name}");
+        let frame = &ctx.setup.frame;
+        let sign = if self.inside { 1.0 } else { -1.0 };
+        // Checked at set-up: the region has a surface, so the distance is there everywhere.
+        let distance = |x: &SVector<f64, D>| {
+            sign * self
+                .region
+                .signed_distance(&frame.point_to_scene(x))
+                .unwrap_or(f64::NAN)
+        };
+        let nodes = sim.node_positions();
+        let (mut lower, mut upper) = (nodes[0], nodes[0]);
+        for x in &nodes {
+            lower = lower.inf(x);
+            upper = upper.sup(x);
+        }
+        // At time t the field is read at x − V t: the box swept back over the run.
+        let swept = self.velocity * ctx.end_time;
+        let (lower, upper) = (lower.inf(&(lower - swept)), upper.sup(&(upper - swept)));
+        let spacing = sim.spacing();
+        let field = SampledDistance::sample(
+            lower.add_scalar(-spacing),
+            upper.add_scalar(spacing),
+            spacing / 2.0,
+            distance,
+        )
+        .map_err(|e| ctx.scene.value_error(key.clone(), e.to_string()))?;
+        let collider = Collider {
+            kind: wall_kind(kind),
+            friction,
+            distance: Arc::new(field),
+        };
+        let (tolerance, reach) = (1e-6 * spacing, NODE_REACH * spacing);
+        let held = if self.velocity.iter().all(|c| *c == 0.0) {
+            sim.add_collider(collider, tolerance, reach)
+        } else {
+            sim.add_moving_collider(collider, self.velocity, tolerance, reach, ctx.end_time)
+        };
+        if held.is_empty() {
+            return Err(ctx.scene.value_error(
+                key,
+                format!("no {} node lies on or beyond its surface", ctx.kernel_name),
+            ));
+        }
+        Ok(held)
+    }
+}
+
 /// A condition on the nodes inside a region of the scene frame.
 struct HeldRegion<'a, const D: usize> {
     region: &'a Region<D>,
     normal: Option<&'a SVector<f64, D>>,
+    friction: f64,
     imposed: Imposed,
     penalty: Option<f64>,
 }
@@ -185,10 +284,10 @@ impl<const D: usize> HeldRegion<'_, D> {
                 sim.boundary_mut().fitted.push(clamp);
             }
             None => sim.boundary_mut().fixed.extend(nodes.iter().copied()),
-            Some(n) => sim
-                .boundary_mut()
-                .slip
-                .extend(nodes.iter().map(|&v| (v, *n))),
+            Some(n) => {
+                let held: Vec<(u32, SVector<f64, D>)> = nodes.iter().map(|&v| (v, *n)).collect();
+                hold(sim, BoundaryKind::Slip, self.friction, &held);
+            }
         }
         Ok(nodes)
     }

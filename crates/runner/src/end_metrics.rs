@@ -1,17 +1,18 @@
 //! Metrics of a run's end state that the scene asks for: the largest value of each
 //! material state scalar, each body's bulk motion where there are several, a front's
-//! advance, the probes' final displacements, and the hydrostatic column's comparison
-//! with its closed form.
+//! advance, the probes' final displacements, the particles found beyond a mesh group's
+//! wall, and the hydrostatic column's comparison with its closed form.
 
 use nalgebra::SVector;
 use serde_json::{Map, Value, json};
 
 use crate::error::Result;
+use crate::group_wall::GroupWall;
 use crate::handle::Run;
 use crate::probes::Probes;
 use crate::scene::Scene;
 use crate::schema::ProfileSpec;
-use crate::setup::Setup;
+use crate::setup::{BoundaryTarget, Setup};
 
 /// The end-state metrics of `sim`; `initial` are the particles' initial (world)
 /// positions, `initial_energy` the run's initial mechanical energy. The column's
@@ -70,6 +71,10 @@ pub(crate) fn end_state<const D: usize>(
             })
             .collect();
         metrics.insert("probe_displacements".into(), json!(finals));
+    }
+    if let Some((crossings, depth)) = wall_crossings(setup, sim) {
+        metrics.insert("wall_crossings".into(), json!(crossings));
+        metrics.insert("max_wall_depth".into(), json!(depth));
     }
     if let (Some(column), false) = (&setup.hydrostatic, failed) {
         let stresses = sim.cauchy_stresses()?;
@@ -155,4 +160,55 @@ fn surface_profile<const D: usize>(
         .map(|h| h.is_finite().then_some(h))
         .collect();
     Ok(json!({ "centres": centres, "heights": heights }))
+}
+
+/// Particles beyond a wall of a mesh group or a shape (obstacle, container) at the end,
+/// for any kernel: how many lie beyond one by more than 1 % of the kernel spacing
+/// (`wall_crossings`), and the deepest one's depth in kernel spacings (`max_wall_depth`).
+/// `None` for scenes without such a wall. A mesh kernel holds its particles on the mesh,
+/// a grid kernel, and any kernel at a shape, through a collider; a particle found beyond
+/// went through the wall.
+fn wall_crossings<const D: usize>(setup: &Setup<D>, sim: &dyn Run<D>) -> Option<(usize, f64)> {
+    let spacing = sim.spacing();
+    let tolerance = 0.01 * spacing;
+    let mut found: Option<(usize, f64)> = None;
+    let mut add = |(count, depth): (usize, f64)| {
+        let (total, deepest) = found.unwrap_or((0, 0.0));
+        found = Some((total + count, f64::max(deepest, depth / spacing)));
+    };
+    for (_, target) in &setup.boundaries {
+        match target {
+            BoundaryTarget::Vertices(vertices) => {
+                let Some(mesh) = setup.background.mesh() else {
+                    continue;
+                };
+                let ids: Vec<u32> = vertices.iter().map(|(v, _)| *v).collect();
+                // A group without boundary facets was refused when the condition was
+                // applied.
+                if let Ok(wall) = GroupWall::new(mesh, &ids) {
+                    add(wall.beyond(sim.positions(), tolerance));
+                }
+            }
+            BoundaryTarget::Shape {
+                region,
+                inside,
+                velocity,
+            } => {
+                let sign = if *inside { 1.0 } else { -1.0 };
+                // Where a moving shape stands now (scene frame).
+                let moved = velocity * sim.time();
+                add(sim
+                    .positions()
+                    .iter()
+                    .filter_map(|x| {
+                        region.signed_distance(&(setup.frame.point_to_scene(x) - moved))
+                    })
+                    .map(|d| sign * d)
+                    .filter(|&d| d > tolerance)
+                    .fold((0, 0.0), |(n, deepest), d| (n + 1, f64::max(deepest, d))));
+            }
+            _ => {}
+        }
+    }
+    found
 }

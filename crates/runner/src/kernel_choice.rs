@@ -36,8 +36,8 @@ pub trait KernelFactory<const D: usize> {
 
     /// Whether the kernel's nodes are the mesh's vertices. A mesh kernel needs the
     /// lattice split into simplices and writes its nodal fields onto `mesh.vtu`; a grid
-    /// kernel (false) writes `grid.vtu`, and walls given as mesh groups reach it as the
-    /// staircase of its nodes outside the mesh.
+    /// kernel (false) writes `grid.vtu`, and walls given as mesh groups reach it as
+    /// signed-distance colliders.
     fn on_mesh(&self) -> bool;
 
     /// The kernel over the scene's background (`setup.background`: a mesh, or the box

@@ -41,6 +41,7 @@ mod end_metrics;
 mod error;
 pub mod expression;
 pub mod frame;
+mod group_wall;
 mod handle;
 pub mod hydrostatic;
 pub mod jitter;

@@ -872,8 +872,8 @@ pub struct PlaneSpec {
     pub normal: Vec<f64>,
 }
 
-/// `[[boundaries]]`: nodes on a plane, the vertices of a physical group, or the nodes in
-/// a region.
+/// `[[boundaries]]`: nodes on a plane, the vertices of a physical group, the nodes in
+/// a region, or the surface of an obstacle or a container.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoundarySpec {
@@ -885,8 +885,21 @@ pub struct BoundarySpec {
     pub group: Option<String>,
     /// The kernel nodes inside this region (any kernel).
     pub region: Option<RegionSpec>,
+    /// A wall around a shape the material stays outside of (any kernel): a
+    /// signed-distance collider of the region's surface.
+    pub obstacle: Option<RegionSpec>,
+    /// A wall around a shape the material stays inside of (any kernel): a
+    /// signed-distance collider of the region's surface.
+    pub container: Option<RegionSpec>,
+    /// The prescribed velocity of an obstacle or container (rigid translation, scene
+    /// frame; default at rest): a footing pressed into the ground, a penetrator.
+    pub velocity: Option<Vec<f64>>,
     /// The wall normal of a slip condition on a region.
     pub normal: Option<Vec<f64>>,
+    /// Coulomb's friction coefficient μ of a slip condition (default 0, frictionless):
+    /// a node moving into the wall loses that motion and up to μ times as much of its
+    /// tangential speed.
+    pub friction: Option<f64>,
     /// How a fixed region holds the body: on its nodes (default), on the fit or on its
     /// face.
     pub imposed: Option<Imposed>,

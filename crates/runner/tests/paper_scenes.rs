@@ -367,8 +367,8 @@ fn cantilever_clamp_holds_and_the_tip_follows_the_reference() {
 
 /// The expanding ball presses on the spherical wall the mesh conforms to: the wall
 /// carries a pressure, nearly the same all around (the problem is symmetric), and the
-/// ball's momentum stays zero; with a grid the wall is a staircase of nodes outside the
-/// mesh and still holds the ball.
+/// ball's momentum stays zero; with a grid the wall is a signed-distance collider of the
+/// mesh's wall facets and still holds the ball, every particle inside it.
 #[test]
 fn expanding_ball_presses_evenly_on_the_curved_wall() {
     for kernel in [KernelKind::LinearFe, KernelKind::Umls, KernelKind::Bspline2] {
@@ -389,8 +389,7 @@ fn expanding_ball_presses_evenly_on_the_curved_wall() {
         }
         // The wall's net force vanishes for a symmetric wall; the mesh's facets are not
         // quite symmetric. Against Σ m|v| = 1.3·10⁴ (2535 kg at a mean 5.1 m/s) the
-        // ball's momentum stays below 1 % on the conforming wall (the staircase's
-        // 1.3 % is in docs/scenes.md).
+        // ball's momentum stays below 1 % on the conforming wall.
         if kernel != KernelKind::Bspline2 {
             assert!(
                 metric(s, "momentum_change") < 130.0,
@@ -398,6 +397,7 @@ fn expanding_ball_presses_evenly_on_the_curved_wall() {
                 s["metrics"]
             );
         }
+        assert_eq!(metric(s, "wall_crossings"), 0.0, "{kernel:?}");
         let text =
             std::fs::read_to_string(out.out.as_deref().unwrap().join("history.csv")).unwrap();
         assert!(text.lines().next().unwrap().contains("reaction0_magnitude"));

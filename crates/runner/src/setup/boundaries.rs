@@ -1,5 +1,6 @@
 //! `[[boundaries]]`: each condition resolved to the geometry it holds (a plane, a
-//! physical group's vertices, or a region of the scene frame).
+//! physical group's vertices, a region of the scene frame, or the surface of an
+//! obstacle or a container).
 
 use nalgebra::SVector;
 use umls_io::gmsh::PhysicalGroup;
@@ -43,11 +44,62 @@ fn target<const D: usize>(
             "weighs a clamp held on its face: give it with imposed = \"face\"",
         ));
     }
+    match (b.friction, b.kind) {
+        (Some(mu), BoundaryKind::Slip) if !(mu.is_finite() && mu >= 0.0) => {
+            return Err(scene.value_error(key("friction"), "must be finite and not negative"));
+        }
+        (Some(_), BoundaryKind::Fixed) => {
+            return Err(scene.value_error(
+                key("friction"),
+                "applies to slip conditions (a fixed one sticks already)",
+            ));
+        }
+        _ => {}
+    }
     if b.normal.is_some() && b.region.is_none() {
         return Err(scene.value_error(
             key("normal"),
             "only a `region` condition takes a normal (a plane has its own)",
         ));
+    }
+    let given = [
+        b.plane.is_some(),
+        b.group.is_some(),
+        b.region.is_some(),
+        b.obstacle.is_some(),
+        b.container.is_some(),
+    ];
+    if given.iter().filter(|&&g| g).count() != 1 {
+        return Err(scene.value_error(
+            format!("boundaries[{i}]"),
+            "give exactly one of `plane`, `group`, `region`, `obstacle` and `container`",
+        ));
+    }
+    if let Some((name, spec, inside)) = b
+        .obstacle
+        .as_ref()
+        .map(|s| ("obstacle", s, false))
+        .or(b.container.as_ref().map(|s| ("container", s, true)))
+    {
+        let shape = region::<D>(scene, &key(name), spec)?;
+        if shape.signed_distance(&SVector::zeros()).is_none() {
+            return Err(scene.value_error(
+                key(name),
+                "needs a surface: a box, ball or half-space, or their combinations",
+            ));
+        }
+        let velocity = match &b.velocity {
+            Some(v) => scene.vector(&key("velocity"), v)?,
+            None => SVector::zeros(),
+        };
+        return Ok(BoundaryTarget::Shape {
+            region: shape,
+            inside,
+            velocity,
+        });
+    }
+    if b.velocity.is_some() {
+        return Err(scene.value_error(key("velocity"), "only an `obstacle` or a `container` moves"));
     }
     match (&b.plane, &b.group, &b.region) {
         (None, None, Some(spec)) => region_target(scene, i, b, spec),
@@ -75,7 +127,7 @@ fn target<const D: usize>(
         }
         _ => Err(scene.value_error(
             format!("boundaries[{i}]"),
-            "give exactly one of `plane`, `group` and `region`",
+            "give exactly one of `plane`, `group`, `region`, `obstacle` and `container`",
         )),
     }
 }

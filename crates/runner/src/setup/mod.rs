@@ -48,6 +48,16 @@ pub enum BoundaryTarget<const D: usize> {
     },
     /// These mesh vertices (with their outward normals, for slip).
     Vertices(Vec<(u32, SVector<f64, D>)>),
+    /// The surface of a region of the scene frame as a wall: the material stays inside
+    /// it (a container) or outside it (an obstacle).
+    Shape {
+        /// The region, in the scene's own frame.
+        region: Region<D>,
+        /// Whether the material is inside the region.
+        inside: bool,
+        /// Its velocity, scene frame (zero: at rest).
+        velocity: SVector<f64, D>,
+    },
     /// The kernel's nodes inside a region of the scene frame (a clamp that need not
     /// conform to the mesh), with the wall normal of a slip condition (world frame).
     Region {

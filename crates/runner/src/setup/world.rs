@@ -69,6 +69,8 @@ impl<const D: usize> Geometry<'_, D> {
                         *n = frame.vector_to_world(n);
                     }
                 }
+                // Its distance is taken in the scene frame (a rotation keeps distances).
+                BoundaryTarget::Shape { .. } => {}
             }
         }
         Ok((background, frame.vector_to_world(&self.gravity)))
