@@ -301,41 +301,24 @@ impl<const D: usize> Boundary<D> {
         live: &[bool],
         mass: Option<&[f64]>,
     ) -> f64 {
-        let works: Vec<f64> = velocity
+        let chunks = velocity
             .par_chunks_mut(NODE_CHUNK)
             .zip(live.par_chunks(SEGMENTS_PER_CHUNK))
-            .enumerate()
+            .enumerate();
+        if self.moving.is_empty() {
+            // Nothing does work: no per-chunk sums to collect.
+            chunks.for_each(|(c, (chunk, live))| self.hold_chunk(c, chunk, live));
+            return 0.0;
+        }
+        let works: Vec<f64> = chunks
             .map(|(c, (chunk, live))| {
                 if !live.iter().any(|&l| l) {
                     return 0.0;
                 }
+                self.hold_chunk(c, chunk, live);
                 let start = (c * NODE_CHUNK) as u32;
-                let end = start + chunk.len() as u32;
-                let fixed = &self.fixed[self.fixed.partition_point(|&n| n < start)
-                    ..self.fixed.partition_point(|&n| n < end)];
-                // Nodes of segments not live are zero and stay so: skipping them spares
-                // the cache misses of a wall's nodes far from the body.
                 let live_node = |node: u32| live[(node - start) as usize / LIVE_SEGMENT];
-                for &node in fixed.iter().filter(|&&n| live_node(n)) {
-                    chunk[(node - start) as usize] = SVector::zeros();
-                }
-                let slip = &self.slip[self.slip.partition_point(|(n, _)| *n < start)
-                    ..self.slip.partition_point(|(n, _)| *n < end)];
-                for (node, normal) in slip.iter().filter(|(n, _)| live_node(*n)) {
-                    let v = &mut chunk[(node - start) as usize];
-                    let vn = v.dot(normal);
-                    if !self.separate || vn < 0.0 {
-                        *v -= normal * vn;
-                    }
-                }
-                let frictional =
-                    &self.frictional[self.frictional.partition_point(|(n, _, _)| *n < start)
-                        ..self.frictional.partition_point(|(n, _, _)| *n < end)];
-                for (node, normal, mu) in frictional.iter().filter(|(n, _, _)| live_node(*n)) {
-                    let v = &mut chunk[(node - start) as usize];
-                    *v = coulomb(v, normal, *mu);
-                }
-                let masses = mass.map(|m| &m[start as usize..end as usize]);
+                let masses = mass.map(|m| &m[start as usize..start as usize + chunk.len()]);
                 self.moving
                     .iter()
                     .map(|obstacle| {
@@ -346,6 +329,39 @@ impl<const D: usize> Boundary<D> {
             .collect();
         // In chunk order: the same sum on any number of threads.
         works.iter().sum()
+    }
+
+    /// The conditions at rest (fixed, slip, frictional) on chunk `c` of [`NODE_CHUNK`]
+    /// nodes, on the nodes of its `live` segments.
+    fn hold_chunk(&self, c: usize, chunk: &mut [SVector<f64, D>], live: &[bool]) {
+        if !live.iter().any(|&l| l) {
+            return;
+        }
+        let start = (c * NODE_CHUNK) as u32;
+        let end = start + chunk.len() as u32;
+        let fixed = &self.fixed
+            [self.fixed.partition_point(|&n| n < start)..self.fixed.partition_point(|&n| n < end)];
+        // Nodes of segments not live are zero and stay so: skipping them spares the cache
+        // misses of a wall's nodes far from the body.
+        let live_node = |node: u32| live[(node - start) as usize / LIVE_SEGMENT];
+        for &node in fixed.iter().filter(|&&n| live_node(n)) {
+            chunk[(node - start) as usize] = SVector::zeros();
+        }
+        let slip = &self.slip[self.slip.partition_point(|(n, _)| *n < start)
+            ..self.slip.partition_point(|(n, _)| *n < end)];
+        for (node, normal) in slip.iter().filter(|(n, _)| live_node(*n)) {
+            let v = &mut chunk[(node - start) as usize];
+            let vn = v.dot(normal);
+            if !self.separate || vn < 0.0 {
+                *v -= normal * vn;
+            }
+        }
+        let frictional = &self.frictional[self.frictional.partition_point(|(n, _, _)| *n < start)
+            ..self.frictional.partition_point(|(n, _, _)| *n < end)];
+        for (node, normal, mu) in frictional.iter().filter(|(n, _, _)| live_node(*n)) {
+            let v = &mut chunk[(node - start) as usize];
+            *v = coulomb(v, normal, *mu);
+        }
     }
 
     /// Whether any node condition is set (walls given as node sets, such as mesh groups).

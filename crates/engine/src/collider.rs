@@ -31,12 +31,12 @@ pub struct Collider<const D: usize> {
 pub type NodeCondition<const D: usize> = (u32, SVector<f64, D>, Option<f64>);
 
 impl<const D: usize> Collider<D> {
-    /// The unit normal into the wall at `x` and φ(x), where the collider is sampled and
-    /// its gradient does not vanish.
-    fn normal(&self, x: &SVector<f64, D>) -> Option<(f64, SVector<f64, D>)> {
+    /// φ(x), the unit normal into the wall at `x` and the length of ∇φ there, where the
+    /// collider is sampled and its gradient does not vanish.
+    fn normal(&self, x: &SVector<f64, D>) -> Option<(f64, SVector<f64, D>, f64)> {
         let (phi, gradient) = self.distance.at(x)?;
         let length = gradient.norm();
-        (length > 0.0).then(|| (phi, gradient / length))
+        (length > 0.0).then(|| (phi, gradient / length, length))
     }
 
     /// The conditions this collider puts on the nodes at `positions`: every node with
@@ -52,7 +52,7 @@ impl<const D: usize> Collider<D> {
             .into_iter()
             .enumerate()
             .filter_map(|(n, x)| {
-                let (phi, normal) = self.normal(&x)?;
+                let (phi, normal, _) = self.normal(&x)?;
                 (phi >= -tolerance && phi <= reach).then(|| {
                     let friction = match self.kind {
                         WallKind::Fixed => None,
@@ -82,17 +82,12 @@ impl<const D: usize> Collider<D> {
         offset: &SVector<f64, D>,
         velocity: &SVector<f64, D>,
     ) -> bool {
-        let Some((phi, gradient)) = self.distance.at(&(*x - offset)) else {
+        let Some((phi, normal, length)) = self.normal(&(*x - offset)) else {
             return false;
         };
         if phi <= 0.0 {
             return false;
         }
-        let length = gradient.norm();
-        if length == 0.0 {
-            return false;
-        }
-        let normal = gradient / length;
         // φ / |∇φ| is the distance to the surface to first order, also where the sampled
         // field is not a unit-gradient distance.
         *x -= normal * (phi / length);
@@ -120,6 +115,7 @@ impl<const D: usize> Collider<D> {
         offset: &SVector<f64, D>,
     ) -> Option<(f64, SVector<f64, D>)> {
         self.normal(&(x - offset))
+            .map(|(phi, normal, _)| (phi, normal))
     }
 }
 

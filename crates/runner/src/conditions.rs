@@ -5,14 +5,14 @@
 //! force is reported.
 
 use nalgebra::SVector;
-use std::sync::Arc;
 
-use umls_engine::{Collider, FittedClamp, Region, SampledDistance, Wall, WallKind, face_points};
+use umls_engine::{FittedClamp, Region, Wall, WallKind, face_points};
 
 use crate::context::Context;
 use crate::error::Result;
-use crate::group_wall::{GroupWall, NODE_REACH};
+use crate::group_wall::GroupWall;
 use crate::handle::Run;
+use crate::sampled_wall::{NODE_REACH, sampled_collider};
 use crate::schema::{BoundaryKind, Imposed};
 use crate::setup::BoundaryTarget;
 
@@ -146,20 +146,34 @@ fn collider<const D: usize>(
         )
     })?;
     let spacing = sim.spacing();
-    let collider = wall
-        .collider(wall_kind(kind), friction, spacing)
-        .map_err(|e| ctx.scene.value_error(key.clone(), e.to_string()))?;
-    let nodes = sim.add_collider(collider, 1e-6 * spacing, NODE_REACH * spacing);
-    if nodes.is_empty() {
+    let distance = |x: &SVector<f64, D>| wall.signed_distance(x, spacing);
+    let collider = sampled_collider(
+        wall_kind(kind),
+        friction,
+        wall.sample_box(spacing),
+        spacing,
+        distance,
+    )
+    .map_err(|e| ctx.scene.value_error(key.clone(), e.to_string()))?;
+    let held = sim.add_collider(collider, 1e-6 * spacing, NODE_REACH * spacing);
+    held_nodes(ctx, key, "the group's wall", held)
+}
+
+/// The nodes a collider holds, or an error naming the condition `key` when it holds
+/// none of the kernel's nodes (on or beyond `surface`).
+fn held_nodes<const D: usize>(
+    ctx: &Context<'_, D>,
+    key: String,
+    surface: &str,
+    held: Vec<u32>,
+) -> Result<Vec<u32>> {
+    if held.is_empty() {
         return Err(ctx.scene.value_error(
             key,
-            format!(
-                "no {} node lies on or beyond the group's wall",
-                ctx.kernel_name
-            ),
+            format!("no {} node lies on or beyond {surface}", ctx.kernel_name),
         ));
     }
-    Ok(nodes)
+    Ok(held)
 }
 
 /// The surface of a region as a wall for any kernel, at rest or in rigid translation.
@@ -204,31 +218,16 @@ impl<const D: usize> ShapeWall<'_, D> {
         let swept = self.velocity * ctx.end_time;
         let (lower, upper) = (lower.inf(&(lower - swept)), upper.sup(&(upper - swept)));
         let spacing = sim.spacing();
-        let field = SampledDistance::sample(
-            lower.add_scalar(-spacing),
-            upper.add_scalar(spacing),
-            spacing / 2.0,
-            distance,
-        )
-        .map_err(|e| ctx.scene.value_error(key.clone(), e.to_string()))?;
-        let collider = Collider {
-            kind: wall_kind(kind),
-            friction,
-            distance: Arc::new(field),
-        };
+        let bounds = (lower.add_scalar(-spacing), upper.add_scalar(spacing));
+        let collider = sampled_collider(wall_kind(kind), friction, bounds, spacing, distance)
+            .map_err(|e| ctx.scene.value_error(key.clone(), e.to_string()))?;
         let (tolerance, reach) = (1e-6 * spacing, NODE_REACH * spacing);
         let held = if self.velocity.iter().all(|c| *c == 0.0) {
             sim.add_collider(collider, tolerance, reach)
         } else {
             sim.add_moving_collider(collider, self.velocity, tolerance, reach, ctx.end_time)
         };
-        if held.is_empty() {
-            return Err(ctx.scene.value_error(
-                key,
-                format!("no {} node lies on or beyond its surface", ctx.kernel_name),
-            ));
-        }
-        Ok(held)
+        held_nodes(ctx, key, "its surface", held)
     }
 }
 

@@ -10,6 +10,7 @@ use crate::error::Result;
 use crate::group_wall::GroupWall;
 use crate::handle::Run;
 use crate::probes::Probes;
+use crate::sampled_wall::count_beyond;
 use crate::scene::Scene;
 use crate::schema::ProfileSpec;
 use crate::setup::{BoundaryTarget, Setup};
@@ -197,15 +198,12 @@ fn wall_crossings<const D: usize>(setup: &Setup<D>, sim: &dyn Run<D>) -> Option<
                 let sign = if *inside { 1.0 } else { -1.0 };
                 // Where a moving shape stands now (scene frame).
                 let moved = velocity * sim.time();
-                add(sim
-                    .positions()
-                    .iter()
-                    .filter_map(|x| {
-                        region.signed_distance(&(setup.frame.point_to_scene(x) - moved))
-                    })
-                    .map(|d| sign * d)
-                    .filter(|&d| d > tolerance)
-                    .fold((0, 0.0), |(n, deepest), d| (n + 1, f64::max(deepest, d))));
+                let distances = sim.positions().iter().filter_map(|x| {
+                    region
+                        .signed_distance(&(setup.frame.point_to_scene(x) - moved))
+                        .map(|d| sign * d)
+                });
+                add(count_beyond(distances, tolerance));
             }
             _ => {}
         }

@@ -55,6 +55,7 @@ pub mod probes;
 mod recorder;
 mod reference;
 pub mod run;
+mod sampled_wall;
 pub mod scene;
 pub mod schema;
 mod seeds;

@@ -1,6 +1,7 @@
 //! Walls and friction through the scene runner: Coulomb friction against the sliding
 //! block's closed form with every kind of kernel, a grid kernel held inside a curved mesh
-//! wall by its signed-distance collider, and the `friction` key's validation.
+//! wall by its signed-distance collider, obstacles at rest and in motion, and the
+//! `friction` key's validation.
 
 use umls_runner::RunError;
 use umls_runner::run::run;
@@ -9,7 +10,7 @@ use umls_runner::schema::KernelKind;
 
 #[path = "common/runs.rs"]
 mod runs;
-use runs::{metric, options, variant};
+use runs::{completed_run, metric, options, variant};
 
 /// The block slides down the turned incline at g (sin θ − μ cos θ) with the mesh kernels,
 /// whose mesh conforms to the incline, and with quadratic B-splines, whose grid the
@@ -19,25 +20,15 @@ use runs::{metric, options, variant};
 fn the_sliding_block_follows_the_closed_form_with_every_kernel() {
     let scene = Scene::load("sliding-block").unwrap();
     for kernel in [KernelKind::Umls, KernelKind::LinearFe, KernelKind::Bspline2] {
-        let report = run(
-            &scene,
-            &options(&format!("slide-{kernel:?}"), Some(kernel), None),
-        )
-        .unwrap();
-        let s = report.summary.to_json();
-        assert_eq!(s["status"], "completed", "{kernel:?}: {s}");
+        let (s, _) = completed_run(&scene, &format!("slide-{kernel:?}"), kernel, None);
         let error = metric(&s, "velocity_rmse");
         assert!(error < 0.02, "{kernel:?}: velocity_rmse {error}");
     }
     // Without friction the block slides faster than the reference: the error is the
     // whole μ g cos θ T, a third of the final speed.
     let frictionless = variant("sliding-block", &[("friction = 0.2", "friction = 0.0")]);
-    let report = run(
-        &frictionless,
-        &options("slide-frictionless", Some(KernelKind::Umls), None),
-    )
-    .unwrap();
-    let error = metric(&report.summary.to_json(), "velocity_rmse");
+    let (s, _) = completed_run(&frictionless, "slide-frictionless", KernelKind::Umls, None);
+    let error = metric(&s, "velocity_rmse");
     assert!(error > 0.25, "frictionless: velocity_rmse {error}");
 }
 
@@ -47,13 +38,7 @@ fn the_sliding_block_follows_the_closed_form_with_every_kernel() {
 fn the_block_sticks_above_the_friction_angle() {
     let scene = variant("sliding-block", &[("friction = 0.2", "friction = 0.8")]);
     for kernel in [KernelKind::Umls, KernelKind::Bspline2] {
-        let report = run(
-            &scene,
-            &options(&format!("stick-{kernel:?}"), Some(kernel), None),
-        )
-        .unwrap();
-        let s = report.summary.to_json();
-        let history = runs::History::read(report.out.as_deref().unwrap());
+        let (s, history) = completed_run(&scene, &format!("stick-{kernel:?}"), kernel, None);
         let mass = history.last("mass");
         let momentum = history.last("momentum_x").hypot(history.last("momentum_y"));
         let free = 10.0 * 0.5 * 0.6;
@@ -72,13 +57,7 @@ fn the_block_sticks_above_the_friction_angle() {
 fn a_curved_mesh_wall_holds_a_grid_kernels_particles() {
     let scene = Scene::load("fluid-bowl").unwrap();
     for kernel in [KernelKind::Bspline2, KernelKind::Bspline3, KernelKind::Umls] {
-        let report = run(
-            &scene,
-            &options(&format!("bowl-wall-{kernel:?}"), Some(kernel), None),
-        )
-        .unwrap();
-        let s = report.summary.to_json();
-        assert_eq!(s["status"], "completed", "{kernel:?}: {s}");
+        let (s, _) = completed_run(&scene, &format!("bowl-wall-{kernel:?}"), kernel, None);
         assert_eq!(metric(&s, "wall_crossings"), 0.0, "{kernel:?}: {s}");
         assert_eq!(metric(&s, "max_wall_depth"), 0.0, "{kernel:?}");
     }
@@ -127,13 +106,8 @@ fn a_container_half_space_holds_the_block_as_the_plane_does() {
         )],
     );
     for kernel in [KernelKind::Umls, KernelKind::Bspline2] {
-        let report = run(
-            &scene,
-            &options(&format!("slide-container-{kernel:?}"), Some(kernel), None),
-        )
-        .unwrap();
-        let s = report.summary.to_json();
-        assert_eq!(s["status"], "completed", "{kernel:?}: {s}");
+        let name = format!("slide-container-{kernel:?}");
+        let (s, _) = completed_run(&scene, &name, kernel, None);
         let error = metric(&s, "velocity_rmse");
         assert!(error < 0.02, "{kernel:?}: velocity_rmse {error}");
         assert_eq!(metric(&s, "wall_crossings"), 0.0, "{kernel:?}");
@@ -159,20 +133,9 @@ fn no_particle_enters_a_ball_obstacle() {
         ],
     );
     for kernel in [KernelKind::Umls, KernelKind::Bspline2] {
-        let report = run(
-            &scene,
-            &options(&format!("bump-{kernel:?}"), Some(kernel), Some(0.45)),
-        )
-        .unwrap();
-        let s = report.summary.to_json();
-        assert_eq!(s["status"], "completed", "{kernel:?}: {s}");
+        let (s, history) = completed_run(&scene, &format!("bump-{kernel:?}"), kernel, Some(0.45));
         assert_eq!(metric(&s, "wall_crossings"), 0.0, "{kernel:?}: {s}");
-        let history = runs::History::read(report.out.as_deref().unwrap());
-        let column = history
-            .header
-            .iter()
-            .position(|h| h == "reaction1_magnitude")
-            .unwrap();
+        let column = history.column("reaction1_magnitude");
         let pushed = history.rows.iter().map(|r| r[column]).fold(0.0, f64::max);
         assert!(pushed > 0.0, "{kernel:?}: the bump never pushed");
     }
@@ -200,19 +163,15 @@ fn a_moving_obstacle_pushes_the_block() {
         ],
     );
     for kernel in [KernelKind::Umls, KernelKind::Bspline2] {
-        let report = run(
-            &scene,
-            &options(&format!("pusher-{kernel:?}"), Some(kernel), Some(0.5)),
-        )
-        .unwrap();
-        let s = report.summary.to_json();
-        assert_eq!(s["status"], "completed", "{kernel:?}: {s}");
+        let (s, history) = completed_run(&scene, &format!("pusher-{kernel:?}"), kernel, Some(0.5));
         assert_eq!(metric(&s, "wall_crossings"), 0.0, "{kernel:?}: {s}");
         // The block rings after the impact: its speed is averaged over the rows after
         // 0.25 s, ten periods of its lowest mode.
-        let history = runs::History::read(report.out.as_deref().unwrap());
-        let column = |name: &str| history.header.iter().position(|h| h == name).unwrap();
-        let (time, px, mass) = (column("time"), column("momentum_x"), column("mass"));
+        let (time, px, mass) = (
+            history.column("time"),
+            history.column("momentum_x"),
+            history.column("mass"),
+        );
         let late: Vec<f64> = history
             .rows
             .iter()

@@ -29,14 +29,22 @@ pub fn metric(summary: &serde_json::Value, name: &str) -> f64 {
 /// The metric `key` of `scene` run with `kernel` (output under `name`); the run must
 /// complete.
 pub fn completed_metric(scene: &Scene, name: &str, kernel: KernelKind, key: &str) -> f64 {
-    let report = umls_runner::run::run(scene, &options(name, Some(kernel), None)).unwrap();
-    assert_eq!(
-        report.summary.to_json()["status"],
-        "completed",
-        "{}",
-        report.summary.to_json()
-    );
-    metric(&report.summary.to_json(), key)
+    metric(&completed_run(scene, name, kernel, None).0, key)
+}
+
+/// The summary and history of `scene` run with `kernel` to `end_time` (the scene's own
+/// when `None`), output under `name`; the run must complete.
+pub fn completed_run(
+    scene: &Scene,
+    name: &str,
+    kernel: KernelKind,
+    end_time: Option<f64>,
+) -> (serde_json::Value, History) {
+    let report = umls_runner::run::run(scene, &options(name, Some(kernel), end_time)).unwrap();
+    let summary = report.summary.to_json();
+    assert_eq!(summary["status"], "completed", "{name}: {summary}");
+    let history = History::read(report.out.as_deref().unwrap());
+    (summary, history)
 }
 
 /// The built-in scene with each `find` replaced by its `replace` (which must occur).
