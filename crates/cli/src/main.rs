@@ -29,7 +29,7 @@ enum Command {
     /// Run a study matrix (scenes × kernels × resolutions, stability sweeps, throughput)
     /// and write a report with charts: report.md, charts/*.svg, results.csv/json.
     Report {
-        /// `quick` (coarse levels, about 4 minutes on 2 cores), `full` (about 2 hours), or
+        /// `quick` (coarse levels, about 4 minutes on 2 cores), `full` (about 1¼ hours), or
         /// the path of a matrix TOML file.
         #[arg(long, default_value = "quick")]
         matrix: String,
